@@ -1,0 +1,327 @@
+//! `survey fit`, `survey predict`, `survey test`, `survey laws`.
+
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+use anyhow::Context;
+use clap::{Args, ValueEnum};
+use robot_survey::dataset::Dataset;
+use robot_survey::regression::Method;
+use robot_survey::report::{self, Format};
+use robot_survey::survey::{self, Group};
+
+use super::{DatasetArgs, print};
+
+/// Line-fitting method (log–log space).
+#[derive(ValueEnum, Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub enum MethodArg {
+    /// Ordinary least squares of log y on log x (the paper's method; use it to predict y).
+    #[default]
+    Ols,
+    /// Major axis: minimises perpendicular distances (symmetric in x and y).
+    Ma,
+    /// Standardised major axis (reduced major axis): the usual allometric line.
+    Sma,
+}
+
+impl From<MethodArg> for Method {
+    fn from(m: MethodArg) -> Self {
+        match m {
+            MethodArg::Ols => Method::Ols,
+            MethodArg::Ma => Method::Ma,
+            MethodArg::Sma => Method::Sma,
+        }
+    }
+}
+
+#[derive(Args, Debug)]
+pub struct FitArgs {
+    #[command(flatten)]
+    pub data: DatasetArgs,
+    /// Output format of the table.
+    #[arg(long, value_enum, default_value_t)]
+    pub format: Format,
+    /// Line-fitting method in log–log space (OLS reproduces the paper's Table 2).
+    #[arg(long, value_enum, default_value_t)]
+    pub method: MethodArg,
+    /// Confidence level of the intervals.
+    #[arg(long, default_value_t = 0.95, value_parser = parse_confidence)]
+    pub confidence: f64,
+    /// Write table2.{md,tex,csv,json} and the survey figure (SVG and PNG) into DIR.
+    #[arg(long, value_name = "DIR")]
+    pub out: Option<PathBuf>,
+    /// Add a seeded case-resampling bootstrap interval of every exponent (N resamples).
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(100..=1_000_000))]
+    pub bootstrap: Option<u32>,
+    /// Seed of the bootstrap (same seed, same intervals).
+    #[arg(long, default_value_t = 1)]
+    pub seed: u64,
+    /// List the robots of CLASS that move each exponent most (leave-one-out change in b).
+    #[arg(long, value_name = "CLASS")]
+    pub explain: Option<String>,
+}
+
+pub fn parse_confidence(s: &str) -> Result<f64, String> {
+    let c: f64 = s.parse().map_err(|_| format!("`{s}` is not a number"))?;
+    if c > 0.0 && c < 1.0 {
+        Ok(c)
+    } else {
+        Err(format!("confidence must be in (0, 1), got {c}"))
+    }
+}
+
+pub fn parse_group(s: &str) -> anyhow::Result<Group> {
+    Group::parse(s).with_context(|| {
+        format!("unknown class `{s}` (one of: lower-biped, full-biped, quadruped, hexapod, all)")
+    })
+}
+
+pub fn fit(a: &FitArgs) -> anyhow::Result<ExitCode> {
+    let ds = Dataset::locate(a.data.dataset.as_deref())?;
+    let table = ds.table(a.data.release.as_deref())?;
+    if let Some(class) = &a.explain {
+        let g = parse_group(class)?;
+        let ex = survey::explain(&table, g, a.method.into())?;
+        print(&match a.format {
+            Format::Json => report::json(&ex)?,
+            _ => report::explain_text(&ex),
+        });
+        return Ok(ExitCode::SUCCESS);
+    }
+    let bootstrap = a
+        .bootstrap
+        .map(|n| robot_survey::regression::BootstrapConfig {
+            replicates: n as usize,
+            seed: a.seed,
+            level: a.confidence,
+        });
+    let t2 = survey::table2_with_bootstrap(&table, a.method.into(), a.confidence, bootstrap)?;
+    if let Some(dir) = &a.out {
+        std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
+        let mut written = Vec::new();
+        for (fmt, name) in [
+            (Format::Md, "table2.md"),
+            (Format::Tex, "table2.tex"),
+            (Format::Csv, "table2.csv"),
+            (Format::Json, "table2.json"),
+        ] {
+            let path = dir.join(name);
+            robot_survey::dataset::canonical::write_atomic(
+                &path,
+                report::table2(&t2, fmt)?.as_bytes(),
+            )?;
+            written.push(path);
+        }
+        let panels = report::plot::survey_panels(&table, &t2);
+        for name in ["survey.svg", "survey.png"] {
+            let path = dir.join(name);
+            report::plot::draw_panels(&path, &panels, (1400, 620))?;
+            written.push(path);
+        }
+        eprintln!(
+            "wrote {}",
+            written
+                .iter()
+                .map(|p| p.display().to_string())
+                .collect::<Vec<_>>()
+                .join(", ")
+        );
+    }
+    print(&report::table2(&t2, a.format)?);
+    Ok(ExitCode::SUCCESS)
+}
+
+#[derive(Args, Debug)]
+#[command(
+    after_help = "Examples:\n  survey predict --leg-length 1.0 --class lower-biped --from zippy\n  survey predict --leg-length 1.0 --from design:mugatu --format json\n  survey predict --mass-budget 30 --class lower-biped\n\n\
+Predictions use the class OLS fit of log10 y on log10 L (MA/SMA lines are not for \
+predicting). The centre is the bias-corrected mean (Duan smearing); the median and the \
+back-transformed confidence and prediction intervals are shown beside it."
+)]
+pub struct PredictArgs {
+    #[command(flatten)]
+    pub data: DatasetArgs,
+    /// Target leg length [m] (hip height standing).
+    #[arg(long, value_name = "M")]
+    pub leg_length: Option<f64>,
+    /// Mass budget [kg]: the inverse query, which leg length the class fit gives for it.
+    #[arg(long, value_name = "KG")]
+    pub mass_budget: Option<f64>,
+    /// Class whose fit predicts (lower-biped, full-biped, quadruped, hexapod, all).
+    #[arg(long, default_value = "lower-biped")]
+    pub class: String,
+    /// Reference to scale isometrically beside the fit: a record id (`zippy`) or a walker
+    /// design (`design:mugatu`).
+    #[arg(long, value_name = "REF")]
+    pub from: Option<String>,
+    /// Confidence level of the intervals.
+    #[arg(long, default_value_t = 0.95, value_parser = parse_confidence)]
+    pub confidence: f64,
+    /// Output: md (text) or json.
+    #[arg(long, value_enum, default_value_t)]
+    pub format: Format,
+    /// Also draw mass vs leg length with each class's prediction band (SVG or PNG by extension).
+    #[arg(long, value_name = "FILE")]
+    pub plot: Option<PathBuf>,
+}
+
+pub fn predict(a: &PredictArgs) -> anyhow::Result<ExitCode> {
+    use robot_survey::predict as p;
+    let ds = Dataset::locate(a.data.dataset.as_deref())?;
+    let table = ds.table(a.data.release.as_deref())?;
+    let class = parse_group(&a.class)?;
+    let reference = match a.from.as_deref() {
+        None => None,
+        Some(r) => Some(match r.strip_prefix("design:") {
+            Some(name) => p::reference_from_design(&ds.files, name)?,
+            None => p::reference_from_record(&table, r).with_context(|| {
+                format!("--from {r}: no record `{r}` with leg length and mass in dataset {} (or use design:NAME)", table.version)
+            })?,
+        }),
+    };
+    let req = p::PredictRequest {
+        leg_length_m: a.leg_length,
+        mass_budget_kg: a.mass_budget,
+        reference,
+        confidence: a.confidence,
+    };
+    let pred = p::predict(&table, class, &req)?;
+    if let Some(path) = &a.plot {
+        let panel = report::plot::prediction_panel(&table, &pred)?;
+        report::plot::draw_panels(path, &[panel], (900, 650))?;
+        eprintln!("wrote {}", path.display());
+    }
+    print(&match a.format {
+        Format::Json => report::json(&pred)?,
+        Format::Md => report::prediction_text(&pred),
+        f => anyhow::bail!("--format {f:?} is not available for predict (use md or json)"),
+    });
+    Ok(ExitCode::SUCCESS)
+}
+
+#[derive(Args, Debug)]
+pub struct TestArgs {
+    #[command(subcommand)]
+    pub test: TestCommand,
+}
+
+/// Variables and output shared by the tests.
+#[derive(Args, Debug)]
+pub struct TestCommon {
+    #[command(flatten)]
+    pub data: DatasetArgs,
+    /// Explanatory variable: leg_length, body_length or mass.
+    #[arg(long, default_value = "leg_length")]
+    pub x: String,
+    /// Response variable: leg_length, body_length or mass.
+    #[arg(long, default_value = "mass")]
+    pub y: String,
+    /// Line-fitting method.
+    #[arg(long, value_enum, default_value_t)]
+    pub method: MethodArg,
+    /// Confidence level (the test's significance level is 1 − confidence).
+    #[arg(long, default_value_t = 0.95, value_parser = parse_confidence)]
+    pub confidence: f64,
+    /// Output: md (text) or json.
+    #[arg(long, value_enum, default_value_t)]
+    pub format: Format,
+}
+
+#[derive(clap::Subcommand, Debug)]
+pub enum TestCommand {
+    /// Is the exponent of one class equal to VALUE (default: isometry, 3 for mass vs length)?
+    Slope {
+        #[command(flatten)]
+        common: TestCommon,
+        /// Class tested.
+        #[arg(long, default_value = "lower-biped")]
+        class: String,
+        /// Hypothesised exponent (default: isometric, 1 for length vs length, 3 for mass vs length).
+        #[arg(long)]
+        value: Option<f64>,
+    },
+    /// Do the classes share one exponent? Then: do they differ in elevation (a shift)?
+    #[command(alias = "elevation")]
+    CommonSlope {
+        #[command(flatten)]
+        common: TestCommon,
+        /// Classes compared, comma separated (default: the four classes).
+        #[arg(long, value_delimiter = ',')]
+        classes: Vec<String>,
+    },
+}
+
+fn parse_var(s: &str) -> anyhow::Result<survey::Var> {
+    survey::Var::parse(s)
+        .with_context(|| format!("unknown variable `{s}` (one of: leg_length, body_length, mass)"))
+}
+
+pub fn test(a: &TestArgs) -> anyhow::Result<ExitCode> {
+    use robot_survey::inference;
+    let common = match &a.test {
+        TestCommand::Slope { common, .. } | TestCommand::CommonSlope { common, .. } => common,
+    };
+    let ds = Dataset::locate(common.data.dataset.as_deref())?;
+    let table = ds.table(common.data.release.as_deref())?;
+    let (x, y) = (parse_var(&common.x)?, parse_var(&common.y)?);
+    let text = match &a.test {
+        TestCommand::Slope { class, value, .. } => {
+            let r = inference::slope(
+                &table,
+                parse_group(class)?,
+                x,
+                y,
+                common.method.into(),
+                *value,
+                common.confidence,
+            )?;
+            match common.format {
+                Format::Json => report::json(&r)?,
+                _ => report::slope_test_text(&r),
+            }
+        }
+        TestCommand::CommonSlope { classes, .. } => {
+            let groups = classes
+                .iter()
+                .map(|c| parse_group(c))
+                .collect::<anyhow::Result<Vec<_>>>()?;
+            let r = inference::common_slope(
+                &table,
+                &groups,
+                x,
+                y,
+                common.method.into(),
+                common.confidence,
+            )?;
+            match common.format {
+                Format::Json => report::json(&r)?,
+                _ => report::comparison_text(&r),
+            }
+        }
+    };
+    print(&text);
+    Ok(ExitCode::SUCCESS)
+}
+
+#[derive(Args, Debug)]
+pub struct LawsArgs {
+    #[command(flatten)]
+    pub data: DatasetArgs,
+    /// Confidence level of the intervals of the exponents from data.
+    #[arg(long, default_value_t = 0.95, value_parser = parse_confidence)]
+    pub confidence: f64,
+    /// Output: md or json.
+    #[arg(long, value_enum, default_value_t)]
+    pub format: Format,
+}
+
+pub fn laws(a: &LawsArgs) -> anyhow::Result<ExitCode> {
+    let ds = Dataset::locate(a.data.dataset.as_deref())?;
+    let table = ds.table(a.data.release.as_deref())?;
+    let t = robot_survey::laws::law_table(&ds, &table, a.confidence)?;
+    print(&match a.format {
+        Format::Json => report::json(&t)?,
+        _ => report::laws_md(&t),
+    });
+    Ok(ExitCode::SUCCESS)
+}

@@ -1,0 +1,104 @@
+//! Command-line parsing and dispatch. Exit codes follow ripgrep: 0 success, 1 problems
+//! found (validation errors, a check that failed), 2 could not run (bad input, I/O).
+
+mod dataset_cmd;
+mod fit_cmd;
+mod sim;
+
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+use clap::{Parser, Subcommand};
+
+/// Exit code: the command ran and found problems.
+pub const EXIT_PROBLEMS: u8 = 1;
+/// Exit code: the command could not run.
+pub const EXIT_ERROR: u8 = 2;
+
+#[derive(Parser, Debug)]
+#[command(
+    name = "survey",
+    version,
+    about = "Allometric scaling of legged robots: curated dataset, power-law fits, walker simulation",
+    long_about = "Allometric scaling of legged robots.\n\n\
+        The curated dataset of legged robots (default: ./dataset when present, else the copy \
+        bundled into this binary) is validated with `survey validate`, fitted with `survey fit` \
+        (the paper's Table 2), queried with `survey predict` and `survey test`, and the \
+        quasi-passive walkers of the paper are simulated with `survey sim walk` and `survey sim scale`.\n\n\
+        Exit codes: 0 success, 1 problems found, 2 could not run."
+)]
+pub struct Cli {
+    #[command(subcommand)]
+    pub command: Command,
+}
+
+/// Options shared by every command that reads the dataset.
+#[derive(clap::Args, Debug, Clone, Default)]
+pub struct DatasetArgs {
+    /// Dataset directory (default: ./dataset when present, else the bundled copy).
+    #[arg(long, value_name = "DIR")]
+    pub dataset: Option<PathBuf>,
+    /// Use a frozen release (e.g. 1.0.0, the table as the paper used it) instead of the live records.
+    #[arg(long, value_name = "X.Y.Z")]
+    pub release: Option<String>,
+}
+
+#[derive(Subcommand, Debug)]
+pub enum Command {
+    /// Check every record of the dataset and the frozen releases; report every problem.
+    Validate(dataset_cmd::ValidateArgs),
+    /// Fit the survey's power laws per class (the paper's Table 2).
+    Fit(fit_cmd::FitArgs),
+    /// Predict mass and body length for a target leg length (or leg length for a mass budget).
+    Predict(fit_cmd::PredictArgs),
+    /// Hypothesis tests on the power laws (slope value, common slope, elevation).
+    Test(fit_cmd::TestArgs),
+    /// The scaling-law comparison: isometric vs biology vs robotics (the paper's Table 1).
+    Laws(fit_cmd::LawsArgs),
+    /// Work on the dataset itself: import the upstream table, format records, cut releases.
+    Dataset(dataset_cmd::DatasetCmdArgs),
+    /// Simulate the quasi-passive walkers (Mugatu, Zippy).
+    Sim(sim::SimArgs),
+}
+
+/// Entry point: parse, run, map errors to exit codes.
+pub fn main() -> ExitCode {
+    let cli = match Cli::try_parse() {
+        Ok(cli) => cli,
+        Err(e) => {
+            // --help and --version are not errors.
+            let code = if e.use_stderr() { EXIT_ERROR } else { 0 };
+            let _ = e.print();
+            return ExitCode::from(code);
+        }
+    };
+    match run(cli) {
+        Ok(code) => code,
+        Err(e) => {
+            eprintln!("survey: error: {e:#}");
+            ExitCode::from(EXIT_ERROR)
+        }
+    }
+}
+
+fn run(cli: Cli) -> anyhow::Result<ExitCode> {
+    match cli.command {
+        Command::Validate(a) => dataset_cmd::validate(&a),
+        Command::Fit(a) => fit_cmd::fit(&a),
+        Command::Predict(a) => fit_cmd::predict(&a),
+        Command::Test(a) => fit_cmd::test(&a),
+        Command::Laws(a) => fit_cmd::laws(&a),
+        Command::Dataset(a) => dataset_cmd::run(&a),
+        Command::Sim(a) => sim::run(&a),
+    }
+}
+
+/// Writes `text` to stdout, ignoring a closed pipe (`survey fit | head`).
+pub fn print(text: &str) {
+    use std::io::Write;
+    let mut out = std::io::stdout().lock();
+    let _ = out.write_all(text.as_bytes());
+    if !text.ends_with('\n') {
+        let _ = out.write_all(b"\n");
+    }
+}

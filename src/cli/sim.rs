@@ -1,0 +1,174 @@
+//! `survey sim …`: the 3D walker simulation.
+
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+use clap::{Args, Subcommand, ValueEnum};
+use robot_survey::report;
+use robot_survey::sim::{self, ContactScaling, Design, MassLaw, WalkOptions};
+
+use super::print;
+
+#[derive(Args, Debug)]
+pub struct SimArgs {
+    #[command(subcommand)]
+    pub command: SimCommand,
+}
+
+#[derive(Subcommand, Debug)]
+pub enum SimCommand {
+    /// Simulate one walk of a design and report its gait (velocity, Froude number,
+    /// attitude amplitudes, cost of transport, peak hip torque).
+    Walk(WalkArgs),
+    /// The scaling study: simulate a design at several leg lengths and fit velocity and
+    /// peak hip torque power laws (dynamic similarity predicts v ∝ L^0.5).
+    Scale(ScaleArgs),
+}
+
+/// What every simulation command needs: the design, how it is scaled, how long it runs.
+#[derive(Args, Debug)]
+pub struct RunArgs {
+    /// Design: a built-in name or a path to a design TOML.
+    #[arg(long, default_value = "mugatu")]
+    pub design: String,
+    /// Mass law used when scaling.
+    #[arg(long, value_enum, default_value_t)]
+    pub mass_law: MassLaw,
+    /// Contact scaling rule.
+    #[arg(long, value_enum, default_value_t)]
+    pub contact: ContactScaling,
+    /// Simulated time [s] (per size for `scale`).
+    #[arg(long, default_value_t = 25.0)]
+    pub duration: f64,
+    /// Seed of a deterministic perturbation of the initial state.
+    #[arg(long)]
+    pub seed: Option<u64>,
+    #[arg(long, value_enum, default_value_t)]
+    pub format: SimFormat,
+}
+
+impl RunArgs {
+    fn options(&self) -> WalkOptions {
+        WalkOptions {
+            mass_law: self.mass_law,
+            contact_scaling: self.contact,
+            duration_s: self.duration,
+            seed: self.seed,
+            ..WalkOptions::default()
+        }
+    }
+}
+
+#[derive(Args, Debug)]
+#[command(
+    after_help = "Example:\n  survey sim scale --design mugatu --leg-lengths 0.05,0.153,0.5,1.0 --mass-law l3\n\n\
+Sizes run in parallel; the result is the same bit for bit whatever the thread count."
+)]
+pub struct ScaleArgs {
+    #[command(flatten)]
+    pub run: RunArgs,
+    /// Leg lengths [m], comma separated (at least 3 for the fits).
+    #[arg(long, value_delimiter = ',', required = true, value_name = "M,M,...")]
+    pub leg_lengths: Vec<f64>,
+    /// Draw velocity and peak torque against leg length (SVG or PNG).
+    #[arg(long, value_name = "FILE")]
+    pub plot: Option<PathBuf>,
+}
+
+#[derive(ValueEnum, Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub enum SimFormat {
+    /// Human-readable summary.
+    #[default]
+    Text,
+    Json,
+}
+
+#[derive(Args, Debug)]
+#[command(
+    after_help = "Examples:\n  survey sim walk --design mugatu\n  survey sim walk --design zippy --leg-length 0.5 --mass-law l3 --format json\n  survey sim walk --design my-walker.toml --trajectory walk.csv --plot walk.svg\n\n\
+Built-in designs: mugatu, zippy, zippy-spherical (dataset/walkers/*.toml); a path to a TOML \
+file of the same shape defines a new one. Scaling to --leg-length keeps dynamic similarity: \
+lengths ∝ L, mass ∝ L² or L³, inertia ∝ m·L², drive frequency ∝ L^(-1/2)."
+)]
+pub struct WalkArgs {
+    #[command(flatten)]
+    pub run: RunArgs,
+    /// Scale the design to this leg length [m].
+    #[arg(long, value_name = "M")]
+    pub leg_length: Option<f64>,
+    /// Servo torque limit or bang-bang torque magnitude [N·m] (default: the design's, scaled).
+    #[arg(long, value_name = "NM")]
+    pub torque_limit: Option<f64>,
+    /// Drive frequency [Hz] (default: the design's, scaled ∝ L^(-1/2)).
+    #[arg(long, value_name = "HZ")]
+    pub frequency: Option<f64>,
+    /// Write the trajectory (time, position, roll/pitch/yaw, hip angle and torque) as CSV.
+    #[arg(long, value_name = "FILE")]
+    pub trajectory: Option<PathBuf>,
+    /// Draw roll, pitch, yaw and hip angle over time and the path seen from above (SVG).
+    #[arg(long, value_name = "FILE")]
+    pub plot: Option<PathBuf>,
+}
+
+pub fn run(a: &SimArgs) -> anyhow::Result<ExitCode> {
+    match &a.command {
+        SimCommand::Walk(w) => walk(w),
+        SimCommand::Scale(s) => scale(s),
+    }
+}
+
+fn scale(a: &ScaleArgs) -> anyhow::Result<ExitCode> {
+    if let Some(bad) = a.leg_lengths.iter().find(|l| !(l.is_finite() && **l > 0.0)) {
+        anyhow::bail!("--leg-lengths: {bad} is not a positive length in metres");
+    }
+    let design = Design::resolve(&a.run.design)?;
+    let base = a.run.options();
+    let bar = indicatif::ProgressBar::new(a.leg_lengths.len() as u64);
+    bar.set_style(
+        indicatif::ProgressStyle::with_template("{msg} [{bar:30}] {pos}/{len} sizes, {elapsed}")
+            .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
+    );
+    bar.set_message(format!("simulating {}", a.run.design));
+    let study =
+        robot_survey::scaling::scaling_study(&design, &a.leg_lengths, &base, &|| bar.inc(1))?;
+    bar.finish_and_clear();
+    if let Some(path) = &a.plot {
+        report::plot::draw_panels(path, &report::plot::scaling_panels(&study), (1200, 520))?;
+        eprintln!("wrote {}", path.display());
+    }
+    print(&match a.run.format {
+        SimFormat::Json => report::json(&study)?,
+        SimFormat::Text => report::scaling_text(&study),
+    });
+    Ok(ExitCode::SUCCESS)
+}
+
+fn walk(a: &WalkArgs) -> anyhow::Result<ExitCode> {
+    let design = Design::resolve(&a.run.design)?;
+    let opts = WalkOptions {
+        leg_length_m: a.leg_length,
+        torque_limit_nm: a.torque_limit,
+        frequency_hz: a.frequency,
+        record_trajectory: a.trajectory.is_some() || a.plot.is_some(),
+        ..a.run.options()
+    };
+    let result = sim::simulate_walk(&design, &opts)?;
+    if let Some(path) = &a.trajectory {
+        sim::write_trajectory_csv(&result.trajectory, path)?;
+        eprintln!("wrote {}", path.display());
+    }
+    if let Some(path) = &a.plot {
+        let r = &result.report;
+        let title = format!(
+            "{} at L = {:.3} m ({:?})",
+            r.design, r.leg_length_m, r.mass_law
+        );
+        sim::write_plot_svg(&result.trajectory, &title, path)?;
+        eprintln!("wrote {}", path.display());
+    }
+    print(&match a.run.format {
+        SimFormat::Json => report::json(&result.report)?,
+        SimFormat::Text => report::walk_text(&result.report),
+    });
+    Ok(ExitCode::SUCCESS)
+}

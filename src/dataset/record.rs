@@ -1,0 +1,577 @@
+//! One robot record (`dataset/robots/ID.toml`): identity, class, fit status, sources and
+//! values, each value pointing at the sources that support it.
+//!
+//! Records are parsed by hand from a `toml::Table` rather than with serde's derive so that
+//! a broken record yields *every* problem it has (unknown keys, wrong types, missing
+//! sources…), each with its field and line, instead of stopping at the first.
+
+use std::collections::BTreeMap;
+
+use serde::Serialize;
+
+use super::problem::{Problem, Rule};
+use super::vocabulary::{FieldType, Vocabulary, line_of_offset};
+
+/// Robot class, per the paper (Sec. II), plus `hybrid` for rows that are not purely legged.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash, Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum RobotClass {
+    LowerBiped,
+    FullBiped,
+    Quadruped,
+    Hexapod,
+    Hybrid,
+}
+
+impl RobotClass {
+    pub const ALL: [RobotClass; 5] = [
+        RobotClass::LowerBiped,
+        RobotClass::FullBiped,
+        RobotClass::Quadruped,
+        RobotClass::Hexapod,
+        RobotClass::Hybrid,
+    ];
+    /// The classes fitted in Table 2, in the paper's column order.
+    pub const FITTED: [RobotClass; 4] = [
+        RobotClass::LowerBiped,
+        RobotClass::FullBiped,
+        RobotClass::Quadruped,
+        RobotClass::Hexapod,
+    ];
+
+    pub fn as_str(self) -> &'static str {
+        match self {
+            RobotClass::LowerBiped => "lower-biped",
+            RobotClass::FullBiped => "full-biped",
+            RobotClass::Quadruped => "quadruped",
+            RobotClass::Hexapod => "hexapod",
+            RobotClass::Hybrid => "hybrid",
+        }
+    }
+
+    /// Human label as in the paper's tables.
+    pub fn label(self) -> &'static str {
+        match self {
+            RobotClass::LowerBiped => "Lower biped",
+            RobotClass::FullBiped => "Full biped",
+            RobotClass::Quadruped => "Quadruped",
+            RobotClass::Hexapod => "Hexapod",
+            RobotClass::Hybrid => "Hybrid",
+        }
+    }
+
+    pub fn parse(s: &str) -> Option<Self> {
+        Self::ALL.into_iter().find(|c| c.as_str() == s)
+    }
+}
+
+impl std::fmt::Display for RobotClass {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.as_str())
+    }
+}
+
+/// What kind of document a source is.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum SourceKind {
+    Paper,
+    Datasheet,
+    Web,
+    Lab,
+    Dataset,
+}
+
+impl SourceKind {
+    pub const ALL: [SourceKind; 5] = [
+        SourceKind::Paper,
+        SourceKind::Datasheet,
+        SourceKind::Web,
+        SourceKind::Lab,
+        SourceKind::Dataset,
+    ];
+    pub fn as_str(self) -> &'static str {
+        match self {
+            SourceKind::Paper => "paper",
+            SourceKind::Datasheet => "datasheet",
+            SourceKind::Web => "web",
+            SourceKind::Lab => "lab",
+            SourceKind::Dataset => "dataset",
+        }
+    }
+    pub fn parse(s: &str) -> Option<Self> {
+        Self::ALL.into_iter().find(|k| k.as_str() == s)
+    }
+}
+
+/// A document that supports values of a record.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Source {
+    /// Short key that values refer to (`source = "s1"`).
+    pub key: String,
+    pub kind: SourceKind,
+    /// URL of the document; `lab` sources may give only a `title`.
+    pub url: Option<String>,
+    pub title: Option<String>,
+    pub note: Option<String>,
+}
+
+/// A value as given by a record.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+#[serde(untagged)]
+pub enum Value {
+    Number(f64),
+    Integer(i64),
+    Text(String),
+    Bool(bool),
+    /// A reported range, either end possibly open (e.g. cost "<250000").
+    Range {
+        min: Option<f64>,
+        max: Option<f64>,
+    },
+}
+
+impl Value {
+    /// The value as a number, if it is a point number or integer.
+    pub fn as_f64(&self) -> Option<f64> {
+        match self {
+            Value::Number(x) => Some(*x),
+            Value::Integer(i) => Some(*i as f64),
+            _ => None,
+        }
+    }
+}
+
+/// A value with its provenance.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Datum {
+    pub value: Value,
+    /// Keys of the record's sources that support this value.
+    pub sources: Vec<String>,
+    pub note: Option<String>,
+}
+
+/// A parsed robot record.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Robot {
+    pub id: String,
+    pub name: String,
+    pub class: RobotClass,
+    /// Used in the power-law fits.
+    pub fit: bool,
+    /// Why the robot is kept but not fitted (required when `fit = false`).
+    pub exclusion: Option<String>,
+    pub note: Option<String>,
+    pub sources: Vec<Source>,
+    /// Values keyed by vocabulary field name (BTreeMap: deterministic order).
+    pub values: BTreeMap<String, Datum>,
+}
+
+impl Robot {
+    pub fn number(&self, field: &str) -> Option<f64> {
+        self.values.get(field).and_then(|d| d.value.as_f64())
+    }
+    pub fn integer(&self, field: &str) -> Option<i64> {
+        match self.values.get(field).map(|d| &d.value) {
+            Some(Value::Integer(i)) => Some(*i),
+            _ => None,
+        }
+    }
+    pub fn text(&self, field: &str) -> Option<&str> {
+        match self.values.get(field).map(|d| &d.value) {
+            Some(Value::Text(s)) => Some(s),
+            _ => None,
+        }
+    }
+    pub fn bool(&self, field: &str) -> Option<bool> {
+        match self.values.get(field).map(|d| &d.value) {
+            Some(Value::Bool(b)) => Some(*b),
+            _ => None,
+        }
+    }
+}
+
+const TOP_KEYS: [&str; 8] = [
+    "id",
+    "name",
+    "class",
+    "fit",
+    "exclusion",
+    "note",
+    "sources",
+    "values",
+];
+
+/// Line of the first line of `text` that assigns `key` (`key =` at line start), if any.
+/// The line finder is deliberately simple: canonical records put one key per line.
+pub fn line_of_key(text: &str, key: &str) -> Option<usize> {
+    text.lines()
+        .position(|l| {
+            let t = l.trim_start();
+            t.strip_prefix(key)
+                .is_some_and(|rest| rest.trim_start().starts_with('='))
+        })
+        .map(|i| i + 1)
+}
+
+/// Parses a record, collecting every problem. Returns the robot when it is usable
+/// (identity, class and fit status readable), even if some values had problems.
+pub fn parse_record(
+    text: &str,
+    file: &str,
+    vocab: &Vocabulary,
+    problems: &mut Vec<Problem>,
+) -> Option<Robot> {
+    let table: toml::Table = match text.parse::<toml::Table>() {
+        Ok(t) => t,
+        Err(e) => {
+            problems.push(
+                Problem::error(
+                    file,
+                    Rule::Parse,
+                    format!("not valid TOML: {}", e.message()),
+                )
+                .line(e.span().map(|s| line_of_offset(text, s.start))),
+            );
+            return None;
+        }
+    };
+    let robot_hint = table.get("id").and_then(|v| v.as_str()).map(str::to_string);
+    let p = |rule, field: &str, msg: String| {
+        let mut pr = Problem::error(file, rule, msg)
+            .field(field)
+            .line(line_of_key(text, field.rsplit('.').next().unwrap_or(field)));
+        pr.robot = robot_hint.clone();
+        pr
+    };
+
+    for key in table.keys() {
+        if !TOP_KEYS.contains(&key.as_str()) {
+            problems.push(p(
+                Rule::UnknownField,
+                key,
+                format!(
+                    "unknown key `{key}` (top-level keys: {}; measured values go under [values])",
+                    TOP_KEYS.join(", ")
+                ),
+            ));
+        }
+    }
+
+    let req_str = |key: &str, problems: &mut Vec<Problem>| -> Option<String> {
+        match table.get(key) {
+            None => {
+                problems.push(p(
+                    Rule::MissingField,
+                    key,
+                    format!("required key `{key}` is missing"),
+                ));
+                None
+            }
+            Some(toml::Value::String(s)) if !s.trim().is_empty() => Some(s.clone()),
+            Some(toml::Value::String(_)) => {
+                problems.push(p(Rule::MissingField, key, format!("`{key}` is empty")));
+                None
+            }
+            Some(other) => {
+                problems.push(p(
+                    Rule::Type,
+                    key,
+                    format!("`{key}` must be a string, found {}", other.type_str()),
+                ));
+                None
+            }
+        }
+    };
+    let id = req_str("id", problems);
+    let name = req_str("name", problems);
+    let class_text = req_str("class", problems);
+    let class = class_text.as_deref().and_then(|c| {
+        let parsed = RobotClass::parse(c);
+        if parsed.is_none() {
+            problems.push(p(
+                Rule::Type,
+                "class",
+                format!(
+                    "unknown class `{c}` (one of: {})",
+                    RobotClass::ALL.map(|c| c.as_str()).join(", ")
+                ),
+            ));
+        }
+        parsed
+    });
+    let fit = match table.get("fit") {
+        None => {
+            problems.push(p(
+                Rule::MissingField,
+                "fit",
+                "required key `fit` (true/false) is missing".into(),
+            ));
+            None
+        }
+        Some(toml::Value::Boolean(b)) => Some(*b),
+        Some(other) => {
+            problems.push(p(
+                Rule::Type,
+                "fit",
+                format!("`fit` must be true or false, found {}", other.type_str()),
+            ));
+            None
+        }
+    };
+    let opt_str = |key: &str, problems: &mut Vec<Problem>| -> Option<String> {
+        match table.get(key) {
+            None => None,
+            Some(toml::Value::String(s)) => Some(s.clone()),
+            Some(other) => {
+                problems.push(p(
+                    Rule::Type,
+                    key,
+                    format!("`{key}` must be a string, found {}", other.type_str()),
+                ));
+                None
+            }
+        }
+    };
+    let exclusion = opt_str("exclusion", problems);
+    let note = opt_str("note", problems);
+
+    let sources = parse_sources(&table, file, text, &robot_hint, problems);
+    let values = parse_values(&table, file, text, &robot_hint, vocab, problems);
+
+    Some(Robot {
+        id: id?,
+        name: name?,
+        class: class?,
+        fit: fit?,
+        exclusion,
+        note,
+        sources,
+        values,
+    })
+}
+
+fn parse_sources(
+    table: &toml::Table,
+    file: &str,
+    text: &str,
+    robot: &Option<String>,
+    problems: &mut Vec<Problem>,
+) -> Vec<Source> {
+    let mut out = Vec::new();
+    let err = |field: String, rule, msg: String| {
+        let mut pr = Problem::error(file, rule, msg)
+            .field(field)
+            .line(line_of_key(text, "key"));
+        pr.robot = robot.clone();
+        pr
+    };
+    let Some(raw) = table.get("sources") else {
+        return out;
+    };
+    let Some(list) = raw.as_array() else {
+        problems.push(err(
+            "sources".into(),
+            Rule::Type,
+            "`sources` must be an array of tables ([[sources]])".into(),
+        ));
+        return out;
+    };
+    for (i, item) in list.iter().enumerate() {
+        let field = format!("sources[{i}]");
+        let Some(t) = item.as_table() else {
+            problems.push(err(field, Rule::Type, "each source must be a table".into()));
+            continue;
+        };
+        for k in t.keys() {
+            if !["key", "kind", "url", "title", "note"].contains(&k.as_str()) {
+                problems.push(err(
+                    format!("{field}.{k}"),
+                    Rule::UnknownField,
+                    format!("unknown source key `{k}` (key, kind, url, title, note)"),
+                ));
+            }
+        }
+        let s = |k: &str| t.get(k).and_then(|v| v.as_str()).map(str::to_string);
+        let Some(key) = s("key") else {
+            problems.push(err(
+                format!("{field}.key"),
+                Rule::MissingField,
+                "source has no `key`".into(),
+            ));
+            continue;
+        };
+        let kind = match s("kind").as_deref().map(SourceKind::parse) {
+            Some(Some(k)) => k,
+            Some(None) | None => {
+                problems.push(err(
+                    format!("{field}.kind"),
+                    Rule::Provenance,
+                    format!(
+                        "source `{key}` needs `kind` = one of {}",
+                        SourceKind::ALL.map(|k| k.as_str()).join(", ")
+                    ),
+                ));
+                continue;
+            }
+        };
+        out.push(Source {
+            key,
+            kind,
+            url: s("url"),
+            title: s("title"),
+            note: s("note"),
+        });
+    }
+    out
+}
+
+fn parse_values(
+    table: &toml::Table,
+    file: &str,
+    text: &str,
+    robot: &Option<String>,
+    vocab: &Vocabulary,
+    problems: &mut Vec<Problem>,
+) -> BTreeMap<String, Datum> {
+    let mut out = BTreeMap::new();
+    let Some(raw) = table.get("values") else {
+        return out;
+    };
+    let Some(values) = raw.as_table() else {
+        let mut pr =
+            Problem::error(file, Rule::Type, "`values` must be a table ([values])").field("values");
+        pr.robot = robot.clone();
+        problems.push(pr);
+        return out;
+    };
+    for (name, raw) in values {
+        let field = format!("values.{name}");
+        let mk = |rule, msg: String| {
+            let mut pr = Problem::error(file, rule, msg)
+                .field(field.clone())
+                .line(line_of_key(text, name));
+            pr.robot = robot.clone();
+            pr
+        };
+        let Some(spec) = vocab.get(name) else {
+            let hint = vocab
+                .fields
+                .iter()
+                .find(|f| f.name.split('_').next() == name.split('_').next())
+                .map(|f| format!(" (did you mean `{}`?)", f.name))
+                .unwrap_or_default();
+            problems.push(mk(
+                Rule::UnknownField,
+                format!(
+                    "unknown field `{name}`{hint}; fields are listed in dataset/vocabulary.toml"
+                ),
+            ));
+            continue;
+        };
+        let Some(t) = raw.as_table() else {
+            problems.push(mk(
+                Rule::Type,
+                format!("`{name}` must be an inline table like {{ value = ..., source = \"s1\" }}"),
+            ));
+            continue;
+        };
+        for k in t.keys() {
+            if !["value", "min", "max", "source", "note"].contains(&k.as_str()) {
+                problems.push(mk(
+                    Rule::UnknownField,
+                    format!("unknown key `{k}` in `{name}` (value, min, max, source, note)"),
+                ));
+            }
+        }
+        let sources = match t.get("source") {
+            None => Vec::new(),
+            Some(toml::Value::String(s)) => vec![s.clone()],
+            Some(toml::Value::Array(a)) if a.iter().all(|v| v.is_str()) => a
+                .iter()
+                .filter_map(|v| v.as_str().map(str::to_string))
+                .collect(),
+            Some(_) => {
+                problems.push(mk(
+                    Rule::Type,
+                    "`source` must be a key or a list of keys".into(),
+                ));
+                Vec::new()
+            }
+        };
+        let note = t.get("note").and_then(|v| v.as_str()).map(str::to_string);
+        let num = |v: &toml::Value| -> Option<f64> {
+            match v {
+                toml::Value::Float(x) => Some(*x),
+                toml::Value::Integer(i) => Some(*i as f64),
+                _ => None,
+            }
+        };
+        let value = match (t.get("value"), t.get("min"), t.get("max")) {
+            (Some(v), None, None) => match (spec.field_type, v) {
+                (FieldType::Number, v) if num(v).is_some() => num(v).map(Value::Number),
+                (FieldType::Integer, toml::Value::Integer(i)) => Some(Value::Integer(*i)),
+                (FieldType::Text, toml::Value::String(s)) => Some(Value::Text(s.clone())),
+                (FieldType::Bool, toml::Value::Boolean(b)) => Some(Value::Bool(*b)),
+                (ty, v) => {
+                    problems.push(mk(
+                        Rule::Type,
+                        format!(
+                            "`{name}` must be {} , found {} `{v}`",
+                            match ty {
+                                FieldType::Number => "a number",
+                                FieldType::Integer => "an integer",
+                                FieldType::Text => "a string",
+                                FieldType::Bool => "true or false",
+                            },
+                            v.type_str()
+                        ),
+                    ));
+                    None
+                }
+            },
+            (None, lo, hi)
+                if (lo.is_some() || hi.is_some()) && spec.field_type == FieldType::Number =>
+            {
+                let lo_v = lo.and_then(num);
+                let hi_v = hi.and_then(num);
+                if (lo.is_some() && lo_v.is_none()) || (hi.is_some() && hi_v.is_none()) {
+                    problems.push(mk(
+                        Rule::Type,
+                        format!("`{name}` range ends must be numbers"),
+                    ));
+                    None
+                } else {
+                    Some(Value::Range {
+                        min: lo_v,
+                        max: hi_v,
+                    })
+                }
+            }
+            (None, None, None) => {
+                problems.push(mk(Rule::MissingField, format!("`{name}` has no `value`")));
+                None
+            }
+            _ => {
+                problems.push(mk(
+                    Rule::Type,
+                    format!(
+                        "`{name}` takes either `value` or a numeric range `min`/`max`, not both"
+                    ),
+                ));
+                None
+            }
+        };
+        if let Some(value) = value {
+            out.insert(
+                name.clone(),
+                Datum {
+                    value,
+                    sources,
+                    note,
+                },
+            );
+        }
+    }
+    out
+}

@@ -1,0 +1,566 @@
+//! The compiled survey table and frozen, versioned releases of it.
+//!
+//! Live records compile into one flat table (one row per robot, point values only: ranges
+//! stay in the records). A release freezes that table as `releases/X.Y.Z/robots.csv` and
+//! `robots.parquet`, with their sha256 in `releases/manifest.toml`; `survey validate`
+//! fails if a frozen file's bytes change.
+
+use std::collections::BTreeMap;
+use std::io::Write;
+use std::path::Path;
+
+use serde::{Deserialize, Serialize};
+use sha2::{Digest, Sha256};
+
+use super::record::{Robot, RobotClass, Value};
+use super::vocabulary::{FieldType, Vocabulary};
+use super::{Dataset, DatasetError, Severity};
+
+pub const MANIFEST: &str = "releases/manifest.toml";
+pub const TABLE_CSV: &str = "robots.csv";
+pub const TABLE_PARQUET: &str = "robots.parquet";
+/// Columns before the vocabulary fields, and after them.
+const ID_COLUMNS: [&str; 5] = ["id", "name", "class", "fit", "exclusion"];
+const SOURCES_COLUMN: &str = "sources";
+
+/// One robot of the compiled table. Cells keep the table's text form, so a table loaded
+/// from a release writes back to the very same bytes.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct SurveyRow {
+    pub id: String,
+    pub name: String,
+    pub class: RobotClass,
+    pub fit: bool,
+    pub exclusion: Option<String>,
+    pub cells: BTreeMap<String, String>,
+}
+
+impl SurveyRow {
+    /// A numeric cell (empty or non-numeric → None).
+    pub fn number(&self, column: &str) -> Option<f64> {
+        self.cells
+            .get(column)
+            .and_then(|s| s.parse::<f64>().ok())
+            .filter(|x| x.is_finite())
+    }
+}
+
+/// The compiled table: live records, or a frozen release.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct SurveyTable {
+    /// Semantic version (the release's, or the live records' `dataset.toml` version).
+    pub version: String,
+    /// Whether this is a frozen release (false: compiled from live records).
+    pub frozen: bool,
+    /// sha256 of the table's CSV bytes: the same data always has the same hash.
+    pub sha256: String,
+    pub columns: Vec<String>,
+    pub rows: Vec<SurveyRow>,
+}
+
+impl SurveyTable {
+    /// The table as CSV (RFC 4180, `\n` line ends, header first).
+    pub fn to_csv(&self) -> Vec<u8> {
+        table_csv(&self.columns, &self.rows)
+    }
+
+    /// The table as Parquet, typed by the vocabulary (numbers f64, integers i64, flags bool).
+    pub fn to_parquet(&self, vocab: &Vocabulary) -> Result<Vec<u8>, DatasetError> {
+        use polars::prelude::*;
+        let mut columns: Vec<Column> = Vec::with_capacity(self.columns.len());
+        for name in &self.columns {
+            let cells = self.rows.iter().map(|r| match name.as_str() {
+                "id" => Some(r.id.clone()),
+                "name" => Some(r.name.clone()),
+                "class" => Some(r.class.as_str().to_string()),
+                "fit" => Some(r.fit.to_string()),
+                "exclusion" => r.exclusion.clone(),
+                _ => r.cells.get(name).filter(|s| !s.is_empty()).cloned(),
+            });
+            let ty = if name == "fit" {
+                Some(FieldType::Bool)
+            } else {
+                vocab.get(name).map(|f| f.field_type)
+            };
+            let col = match ty {
+                Some(FieldType::Number) => Column::new(
+                    name.into(),
+                    cells
+                        .map(|c| c.and_then(|s| s.parse::<f64>().ok()))
+                        .collect::<Vec<_>>(),
+                ),
+                Some(FieldType::Integer) => Column::new(
+                    name.into(),
+                    cells
+                        .map(|c| c.and_then(|s| s.parse::<i64>().ok()))
+                        .collect::<Vec<_>>(),
+                ),
+                Some(FieldType::Bool) => Column::new(
+                    name.into(),
+                    cells.map(|c| c.map(|s| s == "true")).collect::<Vec<_>>(),
+                ),
+                _ => Column::new(name.into(), cells.collect::<Vec<Option<String>>>()),
+            };
+            columns.push(col);
+        }
+        let height = self.rows.len();
+        let mut df = DataFrame::new(height, columns)
+            .map_err(|e| DatasetError::Other(format!("building the Parquet table: {e}")))?;
+        let mut buf = Vec::new();
+        ParquetWriter::new(&mut buf)
+            .with_compression(ParquetCompression::Uncompressed)
+            .with_statistics(StatisticsOptions::empty())
+            .finish(&mut df)
+            .map_err(|e| DatasetError::Other(format!("writing Parquet: {e}")))?;
+        Ok(buf)
+    }
+
+    /// Rows used in fits.
+    pub fn fitted(&self) -> impl Iterator<Item = &SurveyRow> {
+        self.rows.iter().filter(|r| r.fit)
+    }
+}
+
+fn table_csv(columns: &[String], rows: &[SurveyRow]) -> Vec<u8> {
+    let mut w = csv::WriterBuilder::new()
+        .terminator(csv::Terminator::Any(b'\n'))
+        .from_writer(Vec::new());
+    // Writing to a Vec cannot fail except on invariant breaks, which `write_record` reports
+    // as errors we fold into an empty row count; the buffer is returned either way.
+    let _ = w.write_record(columns);
+    for r in rows {
+        let rec: Vec<String> = columns
+            .iter()
+            .map(|c| match c.as_str() {
+                "id" => r.id.clone(),
+                "name" => r.name.clone(),
+                "class" => r.class.as_str().to_string(),
+                "fit" => r.fit.to_string(),
+                "exclusion" => r.exclusion.clone().unwrap_or_default(),
+                _ => r.cells.get(c).cloned().unwrap_or_default(),
+            })
+            .collect();
+        let _ = w.write_record(&rec);
+    }
+    w.into_inner().unwrap_or_default()
+}
+
+pub fn sha256_hex(bytes: &[u8]) -> String {
+    let digest = Sha256::digest(bytes);
+    digest.iter().map(|b| format!("{b:02x}")).collect()
+}
+
+/// Text form of a value in the compiled table. Floats use Rust's shortest round-trip
+/// representation, so parsing the cell gives back the identical f64.
+fn cell(value: &Value) -> String {
+    match value {
+        Value::Number(x) => format!("{x}"),
+        Value::Integer(i) => i.to_string(),
+        Value::Text(s) => s.clone(),
+        Value::Bool(b) => b.to_string(),
+        Value::Range { .. } => String::new(),
+    }
+}
+
+/// Compiles the live records into the survey table.
+pub fn compile(ds: &Dataset) -> SurveyTable {
+    let robots: Vec<&Robot> = ds.robots.iter().map(|(_, r)| r).collect();
+    compile_robots(&ds.vocab, &robots, &ds.meta.version)
+}
+
+/// Compiles robots into the survey table (rows sorted by id).
+pub fn compile_robots(vocab: &Vocabulary, robots: &[&Robot], version: &str) -> SurveyTable {
+    let ds_vocab = vocab;
+    let mut columns: Vec<String> = ID_COLUMNS.iter().map(|s| s.to_string()).collect();
+    columns.extend(ds_vocab.compiled_fields().map(|f| f.name.clone()));
+    columns.push(SOURCES_COLUMN.into());
+    let mut robots: Vec<&Robot> = robots.to_vec();
+    robots.sort_by(|a, b| a.id.cmp(&b.id));
+    let rows: Vec<SurveyRow> = robots
+        .into_iter()
+        .map(|r| {
+            let mut cells: BTreeMap<String, String> = ds_vocab
+                .compiled_fields()
+                .filter_map(|f| {
+                    r.values
+                        .get(&f.name)
+                        .map(|d| (f.name.clone(), cell(&d.value)))
+                })
+                .collect();
+            let urls: Vec<String> = r
+                .sources
+                .iter()
+                .map(|s| {
+                    s.url
+                        .clone()
+                        .or_else(|| s.title.clone())
+                        .unwrap_or_default()
+                })
+                .collect();
+            cells.insert(SOURCES_COLUMN.into(), urls.join(" ; "));
+            SurveyRow {
+                id: r.id.clone(),
+                name: r.name.clone(),
+                class: r.class,
+                fit: r.fit,
+                exclusion: r.exclusion.clone(),
+                cells,
+            }
+        })
+        .collect();
+    let csv = table_csv(&columns, &rows);
+    SurveyTable {
+        version: version.to_string(),
+        frozen: false,
+        sha256: sha256_hex(&csv),
+        columns,
+        rows,
+    }
+}
+
+/// Parses a compiled table from CSV bytes; `file` names it in errors.
+pub fn parse_table_csv(
+    bytes: &[u8],
+    file: &str,
+    version: &str,
+) -> Result<SurveyTable, DatasetError> {
+    let mut rdr = csv::ReaderBuilder::new()
+        .has_headers(true)
+        .from_reader(bytes);
+    let bad = |line: Option<u64>, message: String| DatasetError::Parse {
+        file: file.to_string(),
+        line: line.map(|l| l as usize),
+        message,
+    };
+    let columns: Vec<String> = rdr
+        .headers()
+        .map_err(|e| bad(Some(1), e.to_string()))?
+        .iter()
+        .map(str::to_string)
+        .collect();
+    for needed in ID_COLUMNS {
+        if !columns.iter().any(|c| c == needed) {
+            return Err(bad(Some(1), format!("missing column `{needed}`")));
+        }
+    }
+    let mut rows = Vec::new();
+    for rec in rdr.records() {
+        let rec = rec.map_err(|e| bad(e.position().map(|p| p.line()), e.to_string()))?;
+        let line = rec.position().map(|p| p.line());
+        let get = |c: &str| -> String {
+            columns
+                .iter()
+                .position(|x| x == c)
+                .and_then(|i| rec.get(i))
+                .unwrap_or_default()
+                .to_string()
+        };
+        let class_text = get("class");
+        let class = RobotClass::parse(&class_text)
+            .ok_or_else(|| bad(line, format!("unknown class `{class_text}`")))?;
+        let fit = match get("fit").as_str() {
+            "true" => true,
+            "false" => false,
+            other => {
+                return Err(bad(
+                    line,
+                    format!("`fit` must be true or false, found `{other}`"),
+                ));
+            }
+        };
+        let exclusion = Some(get("exclusion")).filter(|s| !s.is_empty());
+        let cells = columns
+            .iter()
+            .enumerate()
+            .filter(|(_, c)| !ID_COLUMNS.contains(&c.as_str()))
+            .filter_map(|(i, c)| {
+                rec.get(i)
+                    .filter(|s| !s.is_empty())
+                    .map(|s| (c.clone(), s.to_string()))
+            })
+            .collect();
+        rows.push(SurveyRow {
+            id: get("id"),
+            name: get("name"),
+            class,
+            fit,
+            exclusion,
+            cells,
+        });
+    }
+    Ok(SurveyTable {
+        version: version.to_string(),
+        frozen: true,
+        sha256: sha256_hex(bytes),
+        columns,
+        rows,
+    })
+}
+
+/// A file of a frozen release and the hash it must keep.
+#[derive(Debug, Clone, PartialEq, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct ReleaseFile {
+    pub path: String,
+    pub sha256: String,
+}
+
+/// One frozen release.
+#[derive(Debug, Clone, PartialEq, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct Release {
+    pub version: String,
+    pub date: String,
+    pub note: String,
+    #[serde(rename = "file")]
+    pub files: Vec<ReleaseFile>,
+}
+
+/// `releases/manifest.toml`.
+#[derive(Debug, Clone, Default, PartialEq, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct Manifest {
+    #[serde(default, rename = "release")]
+    pub releases: Vec<Release>,
+}
+
+impl Manifest {
+    pub fn parse(text: &str, file: &str) -> Result<Self, DatasetError> {
+        toml::from_str(text).map_err(|e| DatasetError::toml(file, text, &e))
+    }
+
+    pub fn get(&self, version: &str) -> Option<&Release> {
+        self.releases.iter().find(|r| r.version == version)
+    }
+
+    pub fn to_toml(&self) -> Result<String, DatasetError> {
+        let body = toml::to_string(self).map_err(|e| DatasetError::Other(e.to_string()))?;
+        Ok(format!(
+            "# Frozen releases of the compiled robot table. A released file never changes:\n\
+             # `survey validate` checks every sha256 below. Corrections go into the live\n\
+             # records and a new release (see CONTRIBUTING.md).\n\n{body}"
+        ))
+    }
+}
+
+/// Parses `X.Y.Z` into a comparable triple.
+pub fn parse_semver(v: &str) -> Option<(u64, u64, u64)> {
+    let mut it = v.split('.');
+    let t = (
+        it.next()?.parse().ok()?,
+        it.next()?.parse().ok()?,
+        it.next()?.parse().ok()?,
+    );
+    it.next().is_none().then_some(t)
+}
+
+/// Checks a release's files against the manifest; returns one message per mismatch.
+pub fn verify_release(ds: &Dataset, release: &Release) -> Vec<(String, String)> {
+    let mut out = Vec::new();
+    for f in &release.files {
+        let rel = format!("releases/{}", f.path);
+        match ds.files.bytes(&rel) {
+            None => out.push((rel, "frozen release file is missing".to_string())),
+            Some(bytes) => {
+                let got = sha256_hex(bytes);
+                if got != f.sha256 {
+                    out.push((
+                        rel,
+                        format!(
+                            "frozen release {} changed: sha256 is {got}, manifest says {} (never edit a release; put corrections in the live records and cut a new version)",
+                            release.version, f.sha256
+                        ),
+                    ));
+                }
+            }
+        }
+    }
+    out
+}
+
+/// Loads a frozen release's table after checking its bytes.
+pub fn load_release(ds: &Dataset, version: &str) -> Result<SurveyTable, DatasetError> {
+    let manifest = ds.manifest()?;
+    let release = manifest.get(version).ok_or_else(|| {
+        let known: Vec<_> = manifest
+            .releases
+            .iter()
+            .map(|r| r.version.as_str())
+            .collect();
+        DatasetError::Other(format!(
+            "no release {version} in {} (releases: {})",
+            ds.files.display(MANIFEST),
+            if known.is_empty() {
+                "none".to_string()
+            } else {
+                known.join(", ")
+            }
+        ))
+    })?;
+    if let Some((file, msg)) = verify_release(ds, release).into_iter().next() {
+        return Err(DatasetError::Invalid {
+            file: ds.files.display(&file),
+            message: msg,
+        });
+    }
+    let rel = format!("releases/{version}/{TABLE_CSV}");
+    let bytes = ds.files.bytes(&rel).ok_or_else(|| DatasetError::Invalid {
+        file: ds.files.display(&rel),
+        message: "release has no robots.csv".into(),
+    })?;
+    parse_table_csv(bytes, &ds.files.display(&rel), version)
+}
+
+/// Today's date (UTC) as YYYY-MM-DD, from the system clock (civil-from-days, H. Hinnant).
+pub fn today_utc() -> String {
+    let secs = std::time::SystemTime::now()
+        .duration_since(std::time::UNIX_EPOCH)
+        .map(|d| d.as_secs() as i64)
+        .unwrap_or(0);
+    let z = secs.div_euclid(86_400) + 719_468;
+    let era = z.div_euclid(146_097);
+    let doe = z - era * 146_097;
+    let yoe = (doe - doe / 1460 + doe / 36_524 - doe / 146_096) / 365;
+    let doy = doe - (365 * yoe + yoe / 4 - yoe / 100);
+    let mp = (5 * doy + 2) / 153;
+    let d = doy - (153 * mp + 2) / 5 + 1;
+    let m = if mp < 10 { mp + 3 } else { mp - 9 };
+    let y = yoe + era * 400 + i64::from(m <= 2);
+    format!("{y:04}-{m:02}-{d:02}")
+}
+
+/// What `survey dataset release` did.
+#[derive(Debug, Clone, Serialize)]
+pub struct ReleaseOutcome {
+    pub version: String,
+    pub rows: usize,
+    pub fitted: usize,
+    pub files: Vec<ReleaseFile>,
+}
+
+/// Freezes the live records as release `version` into the dataset directory.
+///
+/// Refuses when the version is not the live version, is not newer than every release,
+/// already exists, has no CHANGELOG entry, or the records have validation errors. Files
+/// are written to a temporary directory and renamed into place, so nothing is half-written.
+/// Freezes the live records as release `version`. Validation errors refuse the release
+/// unless `allow_errors` (for a release that must preserve a published table with its
+/// errors, as 1.0.0 does); the count is then written into the manifest note.
+pub fn cut_release(
+    ds: &Dataset,
+    version: &str,
+    date: &str,
+    note: &str,
+    allow_errors: bool,
+) -> Result<ReleaseOutcome, DatasetError> {
+    let dir = ds.files.dir.clone().ok_or_else(|| {
+        DatasetError::Other(
+            "cannot cut a release into the bundled dataset: pass --dataset DIR".into(),
+        )
+    })?;
+    let parsed = parse_semver(version).ok_or_else(|| {
+        DatasetError::Other(format!("`{version}` is not a semantic version X.Y.Z"))
+    })?;
+    if version != ds.meta.version {
+        return Err(DatasetError::Other(format!(
+            "the live records are version {} (dataset.toml); set it to {version} first",
+            ds.meta.version
+        )));
+    }
+    let mut manifest = ds.manifest()?;
+    if manifest.get(version).is_some() {
+        return Err(DatasetError::Other(format!(
+            "release {version} already exists and is frozen"
+        )));
+    }
+    if let Some(newest) = manifest
+        .releases
+        .iter()
+        .filter_map(|r| parse_semver(&r.version))
+        .max()
+        && parsed <= newest
+    {
+        return Err(DatasetError::Other(format!(
+            "{version} is not newer than the latest release {}.{}.{}",
+            newest.0, newest.1, newest.2
+        )));
+    }
+    let changelog = ds.files.text("CHANGELOG.md").unwrap_or("");
+    if !changelog
+        .lines()
+        .any(|l| l.starts_with("## ") && l.contains(version))
+    {
+        return Err(DatasetError::Other(format!(
+            "CHANGELOG.md has no `## {version}` entry: describe what changed before releasing"
+        )));
+    }
+    let report = super::validate::validate(ds);
+    let errors = report
+        .problems
+        .iter()
+        .filter(|p| p.severity == Severity::Error)
+        .count();
+    if errors > 0 && !allow_errors {
+        return Err(DatasetError::Other(format!(
+            "the live records have {errors} validation error(s); run `survey validate` and fix them first \
+             (or --allow-errors to freeze a published table with its known errors)"
+        )));
+    }
+    let note = if errors > 0 {
+        format!("{note} [frozen with {errors} known validation error(s)]")
+            .trim()
+            .to_string()
+    } else {
+        note.to_string()
+    };
+    let table = compile(ds);
+    let csv = table.to_csv();
+    let parquet = table.to_parquet(&ds.vocab)?;
+    let files = vec![
+        ReleaseFile {
+            path: format!("{version}/{TABLE_CSV}"),
+            sha256: sha256_hex(&csv),
+        },
+        ReleaseFile {
+            path: format!("{version}/{TABLE_PARQUET}"),
+            sha256: sha256_hex(&parquet),
+        },
+    ];
+    manifest.releases.push(Release {
+        version: version.to_string(),
+        date: date.to_string(),
+        note,
+        files: files.clone(),
+    });
+    let manifest_text = manifest.to_toml()?;
+
+    let releases_dir = dir.join("releases");
+    let io = |p: &Path, e| DatasetError::Io {
+        path: p.display().to_string(),
+        source: e,
+    };
+    std::fs::create_dir_all(&releases_dir).map_err(|e| io(&releases_dir, e))?;
+    let tmp = releases_dir.join(format!(".tmp-{version}"));
+    if tmp.exists() {
+        std::fs::remove_dir_all(&tmp).map_err(|e| io(&tmp, e))?;
+    }
+    std::fs::create_dir_all(&tmp).map_err(|e| io(&tmp, e))?;
+    for (name, bytes) in [(TABLE_CSV, &csv), (TABLE_PARQUET, &parquet)] {
+        let p = tmp.join(name);
+        std::fs::write(&p, bytes).map_err(|e| io(&p, e))?;
+    }
+    let manifest_tmp = releases_dir.join(".manifest.toml.tmp");
+    let mut f = std::fs::File::create(&manifest_tmp).map_err(|e| io(&manifest_tmp, e))?;
+    f.write_all(manifest_text.as_bytes())
+        .map_err(|e| io(&manifest_tmp, e))?;
+    let final_dir = releases_dir.join(version);
+    std::fs::rename(&tmp, &final_dir).map_err(|e| io(&final_dir, e))?;
+    let manifest_path = dir.join(MANIFEST);
+    std::fs::rename(&manifest_tmp, &manifest_path).map_err(|e| io(&manifest_path, e))?;
+    Ok(ReleaseOutcome {
+        version: version.to_string(),
+        rows: table.rows.len(),
+        fitted: table.fitted().count(),
+        files,
+    })
+}

@@ -1,0 +1,655 @@
+//! `survey validate`: every rule over every record, reporting all problems.
+//!
+//! Rules (their names are in [`Rule`]): parse errors, unknown/missing fields, types,
+//! plausible ranges and unit slips, definitions (leg length ≤ body length, mass_min ≤
+//! mass ≤ mass_max), the paper's class rules, duplicates, provenance of every value,
+//! exclusion reasons, consistency, statistical outliers (warnings), integrity of frozen
+//! releases and freshness of the metadata.
+
+use std::collections::BTreeMap;
+
+use serde::Serialize;
+
+use super::Dataset;
+use super::problem::{Problem, Rule, Severity};
+use super::record::{Robot, RobotClass, SourceKind, Value};
+use super::release::{self, parse_semver};
+use super::vocabulary::FieldType;
+
+/// Standard gravity [m/s²], for Froude numbers.
+pub const G_MPS2: f64 = 9.80665;
+/// Mass over leg length cubed [kg/m³] outside which a unit slip is suspected. The survey
+/// spans about 9 (Ranger) to 3,400 (X2-VelociRoACH); a mass typed in grams lands near 10⁵+.
+pub const MASS_PER_LEG_CUBED: (f64, f64) = (1.0, 20_000.0);
+/// Froude number v²/(gL) above which walking is not possible (inverted-pendulum limit).
+pub const WALK_FROUDE_LIMIT: f64 = 1.0;
+/// |externally studentized residual| above which a fitted robot is reported as an outlier.
+pub const OUTLIER_T: f64 = 3.0;
+
+/// The outcome of validation.
+#[derive(Debug, Clone, Serialize)]
+pub struct ValidationReport {
+    pub dataset: String,
+    pub version: String,
+    pub records: usize,
+    pub problems: Vec<Problem>,
+}
+
+impl ValidationReport {
+    pub fn errors(&self) -> usize {
+        self.problems
+            .iter()
+            .filter(|p| p.severity == Severity::Error)
+            .count()
+    }
+    pub fn warnings(&self) -> usize {
+        self.problems
+            .iter()
+            .filter(|p| p.severity == Severity::Warning)
+            .count()
+    }
+}
+
+/// Validates the whole dataset.
+pub fn validate(ds: &Dataset) -> ValidationReport {
+    let mut problems = ds.parse_problems.clone();
+    check_metadata(ds, &mut problems);
+    for (rel, robot) in &ds.robots {
+        let file = ds.files.display(rel);
+        check_record(ds, rel, &file, robot, &mut problems);
+    }
+    check_duplicates(ds, &mut problems);
+    check_outliers(ds, &mut problems);
+    check_releases(ds, &mut problems);
+    problems.sort_by(|a, b| {
+        (a.severity, &a.file, a.line, &a.field, a.rule)
+            .cmp(&(b.severity, &b.file, b.line, &b.field, b.rule))
+    });
+    ValidationReport {
+        dataset: ds.files.origin.clone(),
+        version: ds.meta.version.clone(),
+        records: ds.robots.len()
+            + ds.parse_problems
+                .iter()
+                .filter(|p| p.rule == Rule::Parse)
+                .count(),
+        problems,
+    }
+}
+
+fn check_metadata(ds: &Dataset, problems: &mut Vec<Problem>) {
+    let file = ds.files.display("dataset.toml");
+    if parse_semver(&ds.meta.version).is_none() {
+        problems.push(
+            Problem::error(
+                &file,
+                Rule::Metadata,
+                format!("version `{}` is not X.Y.Z", ds.meta.version),
+            )
+            .field("version"),
+        );
+    }
+    let expected = super::datapackage::datapackage_json(ds);
+    match ds.files.bytes(super::datapackage::FILE) {
+        None => problems.push(Problem::error(
+            &ds.files.display(super::datapackage::FILE),
+            Rule::Metadata,
+            "datapackage.json is missing (run `survey dataset package`)",
+        )),
+        Some(b) if b != expected.as_bytes() => problems.push(Problem::error(
+            &ds.files.display(super::datapackage::FILE),
+            Rule::Metadata,
+            "datapackage.json is out of date with vocabulary.toml or dataset.toml (run `survey dataset package`)",
+        )),
+        Some(_) => {}
+    }
+}
+
+fn problem(
+    file: &str,
+    robot: &Robot,
+    field: &str,
+    sev: Severity,
+    rule: Rule,
+    msg: String,
+    text: Option<&str>,
+) -> Problem {
+    let key = field.rsplit('.').next().unwrap_or(field);
+    Problem::new(file, sev, rule, msg)
+        .robot(robot.id.clone())
+        .field(field)
+        .line(text.and_then(|t| super::record::line_of_key(t, key)))
+}
+
+fn check_record(ds: &Dataset, rel: &str, file: &str, r: &Robot, problems: &mut Vec<Problem>) {
+    let text = ds
+        .files
+        .bytes(rel)
+        .and_then(|b| std::str::from_utf8(b).ok());
+    let mut push = |field: &str, sev, rule, msg: String| {
+        problems.push(problem(file, r, field, sev, rule, msg, text))
+    };
+    use Severity::{Error, Warning};
+
+    // File name and id.
+    let stem = rel.trim_start_matches("robots/").trim_end_matches(".toml");
+    if stem != r.id {
+        push(
+            "id",
+            Error,
+            Rule::FileName,
+            format!("id `{}` does not match the file name `{stem}.toml`", r.id),
+        );
+    }
+    if r.id.is_empty()
+        || !r
+            .id
+            .bytes()
+            .all(|b| b.is_ascii_lowercase() || b.is_ascii_digit() || b == b'-')
+    {
+        push(
+            "id",
+            Error,
+            Rule::Type,
+            format!("id `{}` must be lowercase letters, digits and `-`", r.id),
+        );
+    }
+
+    // Types, ranges, allowed values.
+    for (name, d) in &r.values {
+        let Some(spec) = ds.vocab.get(name) else {
+            continue;
+        };
+        let field = format!("values.{name}");
+        let nums: Vec<f64> = match &d.value {
+            Value::Number(x) => vec![*x],
+            Value::Integer(i) => vec![*i as f64],
+            Value::Range { min, max } => min.iter().chain(max.iter()).copied().collect(),
+            _ => vec![],
+        };
+        for x in nums {
+            if !x.is_finite() {
+                push(
+                    &field,
+                    Error,
+                    Rule::Type,
+                    format!("`{name}` is not a finite number"),
+                );
+                continue;
+            }
+            let below = spec.min.is_some_and(|m| x < m);
+            let above = spec.max.is_some_and(|m| x > m);
+            if below || above {
+                push(
+                    &field,
+                    Error,
+                    Rule::Range,
+                    format!(
+                        "`{name}` = {x} {} is outside the plausible range [{}, {}] {}; check the unit ({})",
+                        spec.unit,
+                        spec.min.map(|m| m.to_string()).unwrap_or("-inf".into()),
+                        spec.max.map(|m| m.to_string()).unwrap_or("inf".into()),
+                        spec.unit,
+                        spec.description
+                    ),
+                );
+            }
+        }
+        if let Value::Range {
+            min: Some(lo),
+            max: Some(hi),
+        } = d.value
+            && lo > hi
+        {
+            push(
+                &field,
+                Error,
+                Rule::Definition,
+                format!("range min {lo} > max {hi}"),
+            );
+        }
+        if let Value::Range { .. } = d.value
+            && spec.fit_variable
+            && r.fit
+        {
+            push(
+                &field,
+                Error,
+                Rule::Exclusion,
+                format!("`{name}` is used in fits and needs a point `value`, not a range"),
+            );
+        }
+        if spec.field_type == FieldType::Text
+            && !spec.allowed.is_empty()
+            && let Value::Text(s) = &d.value
+            && !spec.allowed.iter().any(|a| a == s)
+        {
+            push(
+                &field,
+                Error,
+                Rule::Range,
+                format!("`{s}` is not one of: {}", spec.allowed.join(" | ")),
+            );
+        }
+        // Provenance of each value.
+        if d.sources.is_empty() {
+            let fitted = spec.fit_variable && r.fit;
+            push(
+                &field,
+                if fitted { Error } else { Warning },
+                Rule::Provenance,
+                if fitted {
+                    format!("`{name}` is used in a fit but names no source")
+                } else {
+                    format!("`{name}` names no source")
+                },
+            );
+        }
+        for key in &d.sources {
+            if !r.sources.iter().any(|s| &s.key == key) {
+                push(
+                    &field,
+                    Error,
+                    Rule::Provenance,
+                    format!("source `{key}` is not among the record's [[sources]]"),
+                );
+            }
+        }
+    }
+
+    // Sources themselves.
+    let mut keys = BTreeMap::new();
+    for (i, s) in r.sources.iter().enumerate() {
+        let field = format!("sources[{i}]");
+        if keys.insert(s.key.clone(), i).is_some() {
+            push(
+                &field,
+                Error,
+                Rule::Provenance,
+                format!("source key `{}` is used twice", s.key),
+            );
+        }
+        match (&s.url, s.kind) {
+            (Some(u), _)
+                if !(u.starts_with("https://") || u.starts_with("http://"))
+                    || u.contains(char::is_whitespace) =>
+            {
+                push(
+                    &format!("{field}.url"),
+                    Error,
+                    Rule::Provenance,
+                    format!("`{u}` is not an http(s) URL"),
+                );
+            }
+            (None, SourceKind::Lab) if s.title.is_some() => {}
+            (None, _) => push(
+                &field,
+                Error,
+                Rule::Provenance,
+                format!(
+                    "source `{}` needs a `url` (or, for kind lab, a `title`)",
+                    s.key
+                ),
+            ),
+            _ => {}
+        }
+    }
+
+    // Fit status.
+    if !r.fit && r.exclusion.as_deref().is_none_or(|e| e.trim().is_empty()) {
+        push(
+            "exclusion",
+            Error,
+            Rule::Exclusion,
+            "a robot kept but not fitted needs an `exclusion` reason".into(),
+        );
+    }
+    if r.fit {
+        if r.class == RobotClass::Hybrid {
+            push(
+                "fit",
+                Error,
+                Rule::Class,
+                "hybrid robots (not purely legged) are not fitted with the legged classes".into(),
+            );
+        }
+        for f in ds.vocab.fields.iter().filter(|f| f.fit_variable) {
+            if r.number(&f.name).is_none()
+                && !matches!(
+                    r.values.get(&f.name).map(|d| &d.value),
+                    Some(Value::Range { .. })
+                )
+            {
+                push(
+                    &format!("values.{}", f.name),
+                    Error,
+                    Rule::Exclusion,
+                    format!(
+                        "fitted robot has no `{}`: add it or set fit = false with a reason",
+                        f.name
+                    ),
+                );
+            }
+        }
+        if r.exclusion.is_some() {
+            push(
+                "exclusion",
+                Warning,
+                Rule::Exclusion,
+                "an exclusion reason on a fitted robot (fit = true)".into(),
+            );
+        }
+    }
+
+    // Definitions.
+    let leg = r.number("leg_length_m");
+    let body = r.number("body_length_m");
+    let mass = r.number("mass_kg");
+    if let (Some(l), Some(b)) = (leg, body)
+        && l > b
+    {
+        push(
+            "values.leg_length_m",
+            Error,
+            Rule::Definition,
+            format!(
+                "leg length {l} m exceeds body length {b} m: leg length is the standing hip height and body length the longest dimension, so L ≤ L_B"
+            ),
+        );
+    }
+    if let Some(m) = mass {
+        if let Some(lo) = r.number("mass_min_kg")
+            && lo > m
+        {
+            push(
+                "values.mass_min_kg",
+                Error,
+                Rule::Definition,
+                format!("mass_min {lo} kg exceeds mass {m} kg"),
+            );
+        }
+        if let Some(hi) = r.number("mass_max_kg")
+            && hi < m
+        {
+            push(
+                "values.mass_max_kg",
+                Error,
+                Rule::Definition,
+                format!("mass_max {hi} kg is below mass {m} kg"),
+            );
+        }
+    }
+    if let (Some(lo), Some(hi)) = (r.number("mass_min_kg"), r.number("mass_max_kg"))
+        && lo > hi
+    {
+        push(
+            "values.mass_min_kg",
+            Error,
+            Rule::Definition,
+            format!("mass_min {lo} kg exceeds mass_max {hi} kg"),
+        );
+    }
+
+    // Unit slips: mass against leg³, body against leg.
+    if let (Some(l), Some(m)) = (leg, mass) {
+        let rho = m / l.powi(3);
+        let (lo, hi) = MASS_PER_LEG_CUBED;
+        if !(lo..=hi).contains(&rho) {
+            let hint = if rho > hi {
+                "a mass typed in grams, or a leg length in the wrong unit?"
+            } else {
+                "a leg length typed in mm or cm, or a mass in tonnes?"
+            };
+            push(
+                "values.mass_kg",
+                Error,
+                Rule::UnitPlausibility,
+                format!(
+                    "mass / leg length³ = {rho:.3e} kg/m³ is outside [{lo}, {hi}] seen across legged robots: {hint}"
+                ),
+            );
+        }
+    }
+    if let (Some(l), Some(b)) = (leg, body)
+        && b / l > 20.0
+    {
+        push(
+            "values.body_length_m",
+            Error,
+            Rule::UnitPlausibility,
+            format!("body length is {:.0}× the leg length: a unit slip?", b / l),
+        );
+    }
+    if let (Some(p), Some(m)) = (r.number("battery_mass_kg"), mass)
+        && p >= m
+    {
+        push(
+            "values.battery_mass_kg",
+            Error,
+            Rule::Consistency,
+            format!("battery mass {p} kg is not less than the robot mass {m} kg"),
+        );
+    }
+    if let (Some(a), Some(n), Some(m)) = (
+        r.number("actuator_mass_kg"),
+        r.integer("actuator_count"),
+        mass,
+    ) && a * n as f64 > m
+    {
+        push(
+            "values.actuator_mass_kg",
+            Error,
+            Rule::Consistency,
+            format!("{n} actuators of {a} kg weigh more than the robot ({m} kg)"),
+        );
+    }
+
+    // Class rules (paper, Sec. II): a biped without upper torso or with < 4 DOF is a
+    // lower biped, any other biped a full biped.
+    if matches!(r.class, RobotClass::LowerBiped | RobotClass::FullBiped) {
+        match r.bool("has_torso") {
+            None => push(
+                "values.has_torso",
+                Error,
+                Rule::Class,
+                "a biped needs `has_torso` to check its class".into(),
+            ),
+            Some(torso) => {
+                let dof = r.integer("dof");
+                let lower = !torso || dof.is_some_and(|d| d < 4);
+                if r.class == RobotClass::FullBiped && lower {
+                    push(
+                        "class",
+                        Error,
+                        Rule::Class,
+                        format!(
+                            "a biped with{} torso and {} DOF is a lower-biped by the paper's rule",
+                            if torso { "" } else { "out" },
+                            dof.map(|d| d.to_string()).unwrap_or("unknown".into())
+                        ),
+                    );
+                }
+                if r.class == RobotClass::LowerBiped && !lower {
+                    push(
+                        "class",
+                        Error,
+                        Rule::Class,
+                        format!(
+                            "a biped with an upper torso and {} DOF is a full-biped by the paper's rule (lower: no torso or < 4 DOF)",
+                            dof.map(|d| d.to_string()).unwrap_or("unknown".into())
+                        ),
+                    );
+                }
+            }
+        }
+    } else if r.values.contains_key("has_torso") && r.class != RobotClass::Hybrid {
+        push(
+            "values.has_torso",
+            Warning,
+            Rule::Class,
+            "`has_torso` only decides between biped classes".into(),
+        );
+    }
+
+    // Consistency with locomotion physics: walking above Froude 1 is impossible.
+    if let Some(l) = leg {
+        for f in ["speed_walking_mps", "speed_normal_mps"] {
+            if let Some(v) = r.number(f) {
+                let fr = v * v / (G_MPS2 * l);
+                let running = r.number("speed_running_mps").is_some_and(|vr| vr >= v);
+                // A biped's "normal" speed is a walking speed; quadrupeds and hexapods
+                // normally trot, bound or run (Froude ≫ 1 for RHex-like runners is real).
+                let biped = matches!(r.class, RobotClass::LowerBiped | RobotClass::FullBiped);
+                let walking = f == "speed_walking_mps" || (biped && !running);
+                if fr > WALK_FROUDE_LIMIT && walking {
+                    push(
+                        &format!("values.{f}"),
+                        Warning,
+                        Rule::Consistency,
+                        format!(
+                            "{v} m/s on a {l} m leg is Froude number v²/(gL) = {fr:.2} > 1, beyond the walk–run limit: is it a running or top speed, or a unit slip?"
+                        ),
+                    );
+                }
+            }
+        }
+    }
+}
+
+fn norm_name(s: &str) -> String {
+    s.chars()
+        .filter(|c| c.is_alphanumeric())
+        .flat_map(char::to_lowercase)
+        .collect()
+}
+
+fn check_duplicates(ds: &Dataset, problems: &mut Vec<Problem>) {
+    let robots: Vec<_> = ds.robots.iter().collect();
+    for (i, (fa, a)) in robots.iter().enumerate() {
+        for (fb, b) in robots.iter().skip(i + 1) {
+            let file = ds.files.display(fb);
+            if a.id == b.id || norm_name(&a.name) == norm_name(&b.name) {
+                problems.push(
+                    Problem::error(
+                        &file,
+                        Rule::Duplicate,
+                        format!("same robot as {} (`{}`)", ds.files.display(fa), a.name),
+                    )
+                    .robot(b.id.clone())
+                    .field("name"),
+                );
+                continue;
+            }
+            let close = |f: &str| match (a.number(f), b.number(f)) {
+                (Some(x), Some(y)) => (x - y).abs() <= 0.005 * x.abs().max(y.abs()),
+                _ => false,
+            };
+            if close("leg_length_m") && close("body_length_m") && close("mass_kg") {
+                problems.push(
+                    Problem::warning(
+                        &file,
+                        Rule::Duplicate,
+                        format!("leg length, body length and mass are within 0.5% of `{}` ({}): the same robot twice?", a.name, ds.files.display(fa)),
+                    )
+                    .robot(b.id.clone()),
+                );
+            }
+        }
+    }
+}
+
+fn check_outliers(ds: &Dataset, problems: &mut Vec<Problem>) {
+    let table = release::compile(ds);
+    for o in crate::survey::outliers(&table, OUTLIER_T) {
+        let Some((rel, _)) = ds.robots.iter().find(|(_, r)| r.id == o.id) else {
+            continue;
+        };
+        problems.push(
+            Problem::warning(
+                &ds.files.display(rel),
+                Rule::Outlier,
+                format!(
+                    "{} vs {}: leave-one-out studentized residual {:+.2} against the {} fit (|t| > {OUTLIER_T}); check the values and their sources",
+                    o.y, o.x, o.t, o.class
+                ),
+            )
+            .robot(o.id.clone())
+            .field(format!("values.{}", o.y_field)),
+        );
+    }
+}
+
+fn check_releases(ds: &Dataset, problems: &mut Vec<Problem>) {
+    let file = ds.files.display(release::MANIFEST);
+    let manifest = match ds.manifest() {
+        Ok(m) => m,
+        Err(e) => {
+            problems.push(Problem::error(&file, Rule::ReleaseIntegrity, e.to_string()));
+            return;
+        }
+    };
+    let mut seen = BTreeMap::new();
+    for r in &manifest.releases {
+        if parse_semver(&r.version).is_none() {
+            problems.push(Problem::error(
+                &file,
+                Rule::ReleaseIntegrity,
+                format!("release `{}` is not X.Y.Z", r.version),
+            ));
+        }
+        if seen.insert(r.version.clone(), ()).is_some() {
+            problems.push(Problem::error(
+                &file,
+                Rule::ReleaseIntegrity,
+                format!("release {} is listed twice", r.version),
+            ));
+        }
+        for (rel, msg) in release::verify_release(ds, r) {
+            problems.push(Problem::error(
+                &ds.files.display(&rel),
+                Rule::ReleaseIntegrity,
+                msg,
+            ));
+        }
+    }
+    // A file under releases/X/ that the manifest does not list is not frozen: flag it.
+    for rel in ds
+        .files
+        .files
+        .keys()
+        .filter(|k| k.starts_with("releases/") && k.as_str() != release::MANIFEST)
+    {
+        let listed = manifest.releases.iter().any(|r| {
+            r.files
+                .iter()
+                .any(|f| format!("releases/{}", f.path) == *rel)
+        });
+        if !listed {
+            problems.push(Problem::error(
+                &ds.files.display(rel),
+                Rule::ReleaseIntegrity,
+                "file in releases/ that the manifest does not list".to_string(),
+            ));
+        }
+    }
+    let newest = manifest
+        .releases
+        .iter()
+        .filter_map(|r| parse_semver(&r.version))
+        .max();
+    if let (Some(n), Some(live)) = (newest, parse_semver(&ds.meta.version))
+        && live < n
+    {
+        problems.push(
+            Problem::error(
+                &ds.files.display("dataset.toml"),
+                Rule::Metadata,
+                format!(
+                    "live version {} is older than the latest release {}.{}.{}",
+                    ds.meta.version, n.0, n.1, n.2
+                ),
+            )
+            .field("version"),
+        );
+    }
+}

@@ -1,0 +1,113 @@
+//! Hypothesis tests over the survey (`survey test`): a slope against a given value
+//! (isometry by default), a common slope among classes (Warton et al. 2006 likelihood
+//! ratio for MA/SMA, ANCOVA F for OLS), and a shift in elevation given the common slope.
+//! This module chooses the data; the statistics are [`crate::regression`]'s.
+
+use serde::Serialize;
+
+use crate::dataset::{RobotClass, SurveyTable};
+use crate::regression::{
+    self, CommonSlopeTest, ElevationComparison, Method, RegressionError, SlopeTest,
+};
+use crate::survey::{DatasetRef, Group, Var, isometric_exponent, log_points};
+
+/// `survey test slope`.
+#[derive(Debug, Clone, Serialize)]
+pub struct SlopeTestReport {
+    pub dataset: DatasetRef,
+    pub class: Group,
+    pub x: Var,
+    pub y: Var,
+    /// The hypothesised exponent and why (given, or isometric).
+    pub hypothesis: String,
+    pub confidence: f64,
+    /// Fitted exponent with its interval.
+    pub b_ci: [f64; 2],
+    pub test: SlopeTest,
+}
+
+/// `survey test common-slope` and `survey test elevation`.
+#[derive(Debug, Clone, Serialize)]
+pub struct GroupComparisonReport {
+    pub dataset: DatasetRef,
+    pub classes: Vec<Group>,
+    pub x: Var,
+    pub y: Var,
+    pub common_slope: CommonSlopeTest,
+    /// Elevation shift among classes, given the common slope.
+    pub elevation: Option<ElevationComparison>,
+}
+
+/// Tests b = `value` (default: the isometric exponent) for one class.
+pub fn slope(
+    table: &SurveyTable,
+    class: Group,
+    x: Var,
+    y: Var,
+    method: Method,
+    value: Option<f64>,
+    confidence: f64,
+) -> Result<SlopeTestReport, RegressionError> {
+    let p = log_points(table, class, x, y)?;
+    let (lx, ly) = (&p.lx, &p.ly);
+    let b0 = value.unwrap_or_else(|| isometric_exponent(x, y));
+    let hypothesis = match value {
+        Some(v) => format!("b = {v}"),
+        None => format!("b = {b0} (isometry)"),
+    };
+    let fit = regression::fit_line(lx, ly, method, confidence)?;
+    let test = regression::slope_test(lx, ly, method, b0)?;
+    Ok(SlopeTestReport {
+        dataset: DatasetRef::of(table),
+        class,
+        x,
+        y,
+        hypothesis,
+        confidence,
+        b_ci: [fit.b_ci.lower, fit.b_ci.upper],
+        test,
+    })
+}
+
+/// Tests for a common slope among `classes` (default: the four classes), then for a
+/// shift in elevation given that slope.
+pub fn common_slope(
+    table: &SurveyTable,
+    classes: &[Group],
+    x: Var,
+    y: Var,
+    method: Method,
+    confidence: f64,
+) -> Result<GroupComparisonReport, RegressionError> {
+    let classes: Vec<Group> = if classes.is_empty() {
+        RobotClass::FITTED
+            .iter()
+            .map(|c| Group::Class(*c))
+            .collect()
+    } else {
+        classes.to_vec()
+    };
+    let data = classes
+        .iter()
+        .map(|g| log_points(table, *g, x, y))
+        .collect::<Result<Vec<_>, _>>()?;
+    let groups: Vec<regression::Group<'_>> = classes
+        .iter()
+        .zip(&data)
+        .map(|(g, p)| regression::Group {
+            label: g.as_str(),
+            x: &p.lx,
+            y: &p.ly,
+        })
+        .collect();
+    let common = regression::slope_com(&groups, method, confidence)?;
+    let elevation = regression::elev_com(&groups, method, confidence).ok();
+    Ok(GroupComparisonReport {
+        dataset: DatasetRef::of(table),
+        classes,
+        x,
+        y,
+        common_slope: common,
+        elevation,
+    })
+}

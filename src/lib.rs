@@ -1,0 +1,19 @@
+//! robot-survey: allometric scaling of legged robots.
+//!
+//! The library is organised by concern; the `survey` binary is a thin layer over it.
+//! - [`dataset`]: curated robot records, upstream import, validation, frozen releases.
+//! - [`regression`]: log–log power laws (OLS, MA, SMA), intervals, tests, diagnostics.
+//! - [`survey`]: the paper's analyses over a dataset (Table 2, predictions).
+//! - [`sim`]: 3D quasi-passive walker simulation; [`scaling`]: the scaling study over it.
+//! - [`predict`], [`inference`], [`laws`]: designer predictions, hypothesis tests, Table 1.
+//! - [`report`]: output formats (md, tex, csv, json) and figures.
+
+pub mod dataset;
+pub mod inference;
+pub mod laws;
+pub mod predict;
+pub mod regression;
+pub mod report;
+pub mod scaling;
+pub mod sim;
+pub mod survey;

@@ -1,0 +1,355 @@
+//! Figures with plotters: log–log scatter plots with fitted power laws, as SVG and PNG.
+//! The font is bundled (assets/fonts) so PNG output is identical on every machine.
+
+use std::path::Path;
+use std::sync::Once;
+
+use plotters::coord::Shift;
+use plotters::prelude::*;
+
+use crate::dataset::{RobotClass, SurveyTable};
+use crate::survey::{Group, Table2, Var, points};
+
+static FONT: Once = Once::new();
+const FONT_BYTES: &[u8] = include_bytes!("../../assets/fonts/DejaVuSans.ttf");
+
+fn register_font() {
+    FONT.call_once(|| {
+        // The bytes are a known-good TTF compiled in; failure would be a build defect.
+        let _ = plotters::style::register_font("sans-serif", FontStyle::Normal, FONT_BYTES);
+    });
+}
+
+/// Error drawing a figure.
+#[derive(Debug, thiserror::Error)]
+#[error("drawing {path}: {message}")]
+pub struct PlotError {
+    pub path: String,
+    pub message: String,
+}
+
+/// Colour of a class in every figure.
+pub fn class_color(c: RobotClass) -> RGBColor {
+    match c {
+        RobotClass::LowerBiped => RGBColor(0xd6, 0x27, 0x28),
+        RobotClass::FullBiped => RGBColor(0x1f, 0x77, 0xb4),
+        RobotClass::Quadruped => RGBColor(0x2c, 0xa0, 0x2c),
+        RobotClass::Hexapod => RGBColor(0x94, 0x67, 0xbd),
+        RobotClass::Hybrid => RGBColor(0x7f, 0x7f, 0x7f),
+    }
+}
+
+/// One series of a log–log panel: points and, optionally, a fitted line y = a·x^b and a band.
+pub struct Series {
+    pub label: String,
+    pub color: RGBColor,
+    pub points: Vec<(f64, f64)>,
+    pub line: Option<(f64, f64)>,
+    /// (x, low, high) of a band to shade (e.g. a prediction interval).
+    pub band: Vec<(f64, f64, f64)>,
+}
+
+/// A log–log panel.
+pub struct Panel {
+    pub title: String,
+    pub x_label: String,
+    pub y_label: String,
+    pub series: Vec<Series>,
+}
+
+/// A tick label with at most 3 significant digits (log axes otherwise print float noise
+/// such as 0.30000000000000004).
+fn tick(v: &f64) -> String {
+    let s = super::sig(*v);
+    if s.contains('.') {
+        s.trim_end_matches('0').trim_end_matches('.').to_string()
+    } else {
+        s
+    }
+}
+
+fn bounds(values: impl Iterator<Item = f64>) -> (f64, f64) {
+    let (lo, hi) = values
+        .filter(|v| v.is_finite() && *v > 0.0)
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| {
+            (a.min(v), b.max(v))
+        });
+    if lo.is_finite() && hi.is_finite() {
+        (lo / 1.6, hi * 1.6)
+    } else {
+        (0.01, 1.0)
+    }
+}
+
+fn draw_panel<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    panel: &Panel,
+) -> Result<(), String> {
+    let xr = bounds(panel.series.iter().flat_map(|s| {
+        s.points
+            .iter()
+            .map(|p| p.0)
+            .chain(s.band.iter().map(|b| b.0))
+    }));
+    let yr = bounds(panel.series.iter().flat_map(|s| {
+        s.points
+            .iter()
+            .map(|p| p.1)
+            .chain(s.band.iter().flat_map(|b| [b.1, b.2]))
+    }));
+    let mut chart = ChartBuilder::on(area)
+        .caption(&panel.title, ("sans-serif", 20))
+        .margin(12)
+        .x_label_area_size(40)
+        .y_label_area_size(60)
+        .build_cartesian_2d((xr.0..xr.1).log_scale(), (yr.0..yr.1).log_scale())
+        .map_err(|e| e.to_string())?;
+    chart
+        .configure_mesh()
+        .x_desc(&panel.x_label)
+        .y_desc(&panel.y_label)
+        .x_label_formatter(&tick)
+        .y_label_formatter(&tick)
+        .label_style(("sans-serif", 13))
+        .draw()
+        .map_err(|e| e.to_string())?;
+    for s in &panel.series {
+        let color = s.color;
+        if !s.band.is_empty() {
+            let mut poly: Vec<(f64, f64)> = s.band.iter().map(|b| (b.0, b.2)).collect();
+            poly.extend(s.band.iter().rev().map(|b| (b.0, b.1)));
+            chart
+                .draw_series(std::iter::once(Polygon::new(
+                    poly,
+                    color.mix(0.15).filled(),
+                )))
+                .map_err(|e| e.to_string())?;
+        }
+        let anno = chart
+            .draw_series(
+                s.points
+                    .iter()
+                    .map(|&(x, y)| Circle::new((x, y), 4, color.filled())),
+            )
+            .map_err(|e| e.to_string())?;
+        anno.label(&s.label)
+            .legend(move |(x, y)| Circle::new((x + 8, y), 4, color.filled()));
+        if let Some((a, b)) = s.line {
+            let (lo, hi) = s
+                .points
+                .iter()
+                .map(|p| p.0)
+                .chain(s.band.iter().map(|p| p.0))
+                .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), v| {
+                    (l.min(v), h.max(v))
+                });
+            if lo.is_finite() && hi > lo {
+                let steps = 50;
+                let line = (0..=steps).map(|i| {
+                    let x = lo * (hi / lo).powf(i as f64 / steps as f64);
+                    (x, a * x.powf(b))
+                });
+                chart
+                    .draw_series(LineSeries::new(line, color.stroke_width(2)))
+                    .map_err(|e| e.to_string())?;
+            }
+        }
+    }
+    chart
+        .configure_series_labels()
+        .background_style(WHITE.mix(0.85))
+        .border_style(BLACK)
+        .label_font(("sans-serif", 13))
+        .position(SeriesLabelPosition::UpperLeft)
+        .draw()
+        .map_err(|e| e.to_string())?;
+    Ok(())
+}
+
+/// Draws panels side by side into an SVG or PNG file (by extension).
+pub fn draw_panels(path: &Path, panels: &[Panel], size: (u32, u32)) -> Result<(), PlotError> {
+    register_font();
+    let err = |message: String| PlotError {
+        path: path.display().to_string(),
+        message,
+    };
+    let ext = path
+        .extension()
+        .and_then(|e| e.to_str())
+        .unwrap_or("")
+        .to_ascii_lowercase();
+    let n = panels.len().max(1);
+    macro_rules! render {
+        ($backend:expr) => {{
+            let root = $backend.into_drawing_area();
+            root.fill(&WHITE).map_err(|e| err(e.to_string()))?;
+            let areas = root.split_evenly((1, n));
+            for (area, panel) in areas.iter().zip(panels) {
+                draw_panel(area, panel).map_err(err)?;
+            }
+            root.present().map_err(|e| err(e.to_string()))?;
+        }};
+    }
+    match ext.as_str() {
+        "svg" => render!(SVGBackend::new(path, size)),
+        "png" => render!(BitMapBackend::new(path, size)),
+        other => {
+            return Err(err(format!(
+                "unsupported figure format `.{other}` (use .svg or .png)"
+            )));
+        }
+    }
+    Ok(())
+}
+
+/// The survey figure: mass and body length against leg length per class, log–log, with
+/// each class's fitted power law.
+pub fn survey_panels(table: &SurveyTable, t2: &Table2) -> Vec<Panel> {
+    let panel = |y: Var, title: &str, y_label: &str| Panel {
+        title: title.to_string(),
+        x_label: "leg length L [m]".into(),
+        y_label: y_label.to_string(),
+        series: RobotClass::FITTED
+            .into_iter()
+            .map(|c| {
+                let g = Group::Class(c);
+                let fit = t2
+                    .fits
+                    .iter()
+                    .find(|f| f.class == g && f.x == Var::LegLength && f.y == y);
+                Series {
+                    label: match fit {
+                        Some(f) => format!("{} (b = {:.2}, R² = {:.2})", c.label(), f.b, f.r2),
+                        None => c.label().to_string(),
+                    },
+                    color: class_color(c),
+                    points: points(table, g, Var::LegLength, y)
+                        .into_iter()
+                        .map(|p| (p.1, p.2))
+                        .collect(),
+                    line: fit.map(|f| (f.a, f.b)),
+                    band: Vec::new(),
+                }
+            })
+            .collect(),
+    };
+    vec![
+        panel(Var::Mass, "Mass vs leg length", "mass m [kg]"),
+        panel(
+            Var::BodyLength,
+            "Body length vs leg length",
+            "body length L_B [m]",
+        ),
+    ]
+}
+
+/// `survey predict --plot`: mass vs leg length with each class's prediction band, the
+/// target's prediction and the L² / L³ scaling of the reference.
+pub fn prediction_panel(
+    table: &SurveyTable,
+    pred: &crate::predict::Prediction,
+) -> Result<Panel, crate::predict::PredictError> {
+    let all = points(table, Group::All, Var::LegLength, Var::Mass);
+    let mut lo = all.iter().map(|p| p.1).fold(f64::INFINITY, f64::min);
+    let mut hi = all.iter().map(|p| p.1).fold(f64::NEG_INFINITY, f64::max);
+    if let Some(l) = pred.leg_length_m {
+        lo = lo.min(l);
+        hi = hi.max(l);
+    }
+    let mut series = Vec::new();
+    for c in RobotClass::FITTED {
+        let g = Group::Class(c);
+        let (law, band) = crate::predict::mass_band(table, g, pred.confidence, [lo, hi])?;
+        series.push(Series {
+            label: format!("{} m = {:.3}·L^{:.2}", c.label(), law.a, law.b),
+            color: class_color(c),
+            points: points(table, g, Var::LegLength, Var::Mass)
+                .into_iter()
+                .map(|p| (p.1, p.2))
+                .collect(),
+            line: Some((law.a, law.b)),
+            band,
+        });
+    }
+    if let (Some(l), Some(q)) = (
+        pred.leg_length_m,
+        pred.quantities.iter().find(|q| q.quantity == Var::Mass),
+    ) {
+        series.push(Series {
+            label: format!(
+                "target L = {l} m: {} fit {} kg",
+                pred.class.as_str(),
+                super::sig(q.mean)
+            ),
+            color: BLACK,
+            points: vec![(l, q.mean)],
+            line: None,
+            band: Vec::new(),
+        });
+    }
+    if let Some(s) = &pred.scaled_reference {
+        let r = &s.reference;
+        for (exp, mass, color) in [
+            (2.0, s.mass_l2_kg, RGBColor(0xff, 0x7f, 0x0e)),
+            (3.0, s.mass_l3_kg, RGBColor(0x8c, 0x56, 0x4b)),
+        ] {
+            series.push(Series {
+                label: format!("{} scaled m ∝ L^{exp:.0}: {} kg", r.name, super::sig(mass)),
+                color,
+                points: vec![
+                    (r.leg_length_m, r.mass_kg),
+                    (r.leg_length_m * s.scale_factor, mass),
+                ],
+                line: Some((r.mass_kg / r.leg_length_m.powf(exp), exp)),
+                band: Vec::new(),
+            });
+        }
+    }
+    Ok(Panel {
+        title: format!(
+            "Mass vs leg length, {:.0}% prediction bands",
+            pred.confidence * 100.0
+        ),
+        x_label: "leg length L [m]".into(),
+        y_label: "mass m [kg]".into(),
+        series,
+    })
+}
+
+/// `survey sim scale --plot`: velocity and peak hip torque against leg length, log–log,
+/// with the fitted power laws.
+pub fn scaling_panels(s: &crate::scaling::ScalingStudy) -> Vec<Panel> {
+    let walking: Vec<&crate::sim::WalkReport> = s.walks.iter().filter(|w| w.walks).collect();
+    let panel = |title: &str,
+                 y_label: &str,
+                 y: fn(&crate::sim::WalkReport) -> f64,
+                 law: &Option<crate::scaling::StudyLaw>| Panel {
+        title: title.to_string(),
+        x_label: "leg length L [m]".into(),
+        y_label: y_label.to_string(),
+        series: vec![Series {
+            label: match law {
+                Some(l) => format!("{} (b = {:.3}, R² = {:.3})", s.design, l.b, l.r2),
+                None => s.design.clone(),
+            },
+            color: RGBColor(0x1f, 0x77, 0xb4),
+            points: walking.iter().map(|w| (w.leg_length_m, y(w))).collect(),
+            line: law.as_ref().map(|l| (l.a, l.b)),
+            band: Vec::new(),
+        }],
+    };
+    vec![
+        panel(
+            "Walking speed",
+            "velocity v [m/s]",
+            |w| w.velocity_mps,
+            &s.velocity_law,
+        ),
+        panel(
+            "Peak hip torque",
+            "peak torque τ [N·m]",
+            |w| w.peak_torque_nm,
+            &s.torque_law,
+        ),
+    ]
+}

@@ -1,0 +1,704 @@
+//! Walker designs as data (TOML), their validation, and scaling to another leg length.
+
+use std::path::Path;
+
+use nalgebra::{Matrix3, UnitQuaternion, Vector3};
+use rand::{Rng, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+use serde::{Deserialize, Serialize};
+
+use super::contact::ContactParams;
+use super::control::Controller;
+use super::effects::EffectSpec;
+use super::error::SimError;
+use super::model::{FootSection, Hardstop, Leg, Model, State};
+
+/// Standard gravity [m/s²].
+pub const GRAVITY_MPS2: f64 = 9.81;
+
+/// Built-in designs (bundled so the binary works from any directory).
+pub const BUILTIN_DESIGNS: [(&str, &str); 3] = [
+    ("mugatu", include_str!("../../dataset/walkers/mugatu.toml")),
+    ("zippy", include_str!("../../dataset/walkers/zippy.toml")),
+    (
+        "zippy-spherical",
+        include_str!("../../dataset/walkers/zippy-spherical.toml"),
+    ),
+];
+
+/// How mass follows leg length when a design is scaled.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, Default, clap::ValueEnum)]
+#[serde(rename_all = "lowercase")]
+pub enum MassLaw {
+    /// m ∝ L² (the survey's lower-biped trend).
+    #[default]
+    L2,
+    /// m ∝ L³ (isometric, constant density).
+    L3,
+}
+
+impl MassLaw {
+    pub fn exponent(self) -> f64 {
+        match self {
+            MassLaw::L2 => 2.0,
+            MassLaw::L3 => 3.0,
+        }
+    }
+}
+
+/// Rule for the contact parameters when a design is scaled.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, Default, clap::ValueEnum)]
+#[serde(rename_all = "kebab-case")]
+pub enum ContactScaling {
+    /// Dynamic similarity: the foot's static sinkage stays the same fraction of L and the
+    /// Hunt–Crossley damping the same fraction of the gait's speeds, so E ∝ m/L²
+    /// (since F = πEδ² must scale like m·g with δ ∝ L) and d ∝ L^(−1/2) (d·v constant with
+    /// v ∝ √(gL)); μ unchanged. For m ∝ L² this keeps E fixed. Default: isolates the effect
+    /// of size on the gait from that of foot softness.
+    #[default]
+    Similar,
+    /// Same foot material at every size (what a real robot built of the same rubber has):
+    /// E, d, μ unchanged. For m ∝ L³ large robots then sink relatively deeper
+    /// (δ/L ∝ L^(1/2)).
+    FixedMaterial,
+}
+
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Geometry {
+    pub leg_length_m: f64,
+    pub body_length_m: f64,
+    /// (R_X forward, R_Y lateral, R_Z vertical).
+    pub foot_semi_axes_m: [f64; 3],
+    /// Lateral distance of each leg's centre line from the mid-plane, / L.
+    pub hip_half_width_over_l: f64,
+    /// Lateral offset of each foot ellipsoid centre from the mid-plane, / L.
+    pub foot_center_lateral_over_l: f64,
+    /// Forward offset of each foot ellipsoid centre from the hip, / L.
+    #[serde(default)]
+    pub foot_center_forward_over_l: f64,
+    /// Each foot is the outer part of its ellipsoid beyond the plane at this lateral
+    /// distance from the mid-plane, / L (absent: the whole ellipsoid).
+    #[serde(default)]
+    pub foot_section_cut_over_l: Option<f64>,
+}
+
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct MassSpec {
+    pub total_mass_kg: f64,
+    /// Height of each leg's centre of mass above the ground when standing, / L.
+    pub leg_com_height_over_l: f64,
+    /// Forward offset of each leg's centre of mass from the hip, / L.
+    #[serde(default)]
+    pub leg_com_forward_over_l: f64,
+    /// Edges (x, y, z) / L of the uniform box with each leg's inertia about its COM.
+    pub leg_inertia_box_over_l: [f64; 3],
+}
+
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ContactSpec {
+    pub hydroelastic_modulus_pa: f64,
+    pub hunt_crossley_dissipation_s_per_m: f64,
+    pub friction_mu: f64,
+    pub stiction_speed_mps: f64,
+}
+
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "kind", rename_all = "snake_case", deny_unknown_fields)]
+pub enum ControlSpec {
+    ServoSine {
+        amplitude_deg: f64,
+        frequency_hz: f64,
+        /// Proportional gain / (m·g·L) [1/rad].
+        kp_over_mgl: f64,
+        /// Derivative gain / (m·g·L·√(L/g)) [s/rad · 1/s].
+        kd_over_mgl_sqrt_l_over_g: f64,
+        torque_limit_nm: f64,
+    },
+    BangBang {
+        torque_nm: f64,
+        frequency_hz: f64,
+    },
+}
+
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct HardstopSpec {
+    pub limit_deg: f64,
+    /// Stiffness / (m·g·L) [1/rad].
+    pub stiffness_over_mgl: f64,
+    /// Damping / (m·g·L·√(L/g)).
+    pub damping_over_mgl_sqrt_l_over_g: f64,
+}
+
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct InitialSpec {
+    /// Initial roll onto the right foot [deg] (a symmetric start never rocks).
+    pub roll_deg: f64,
+    /// Standard deviation of the seeded perturbation of roll, pitch and yaw [deg].
+    pub seed_angle_sd_deg: f64,
+    /// Standard deviation of the seeded angular velocity, / √(g/L).
+    pub seed_rate_sd_over_sqrt_g_over_l: f64,
+}
+
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct NumericsSpec {
+    /// Integrator time step at this design's size [s] (scaled ∝ √L).
+    pub time_step_s: f64,
+}
+
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CriteriaSpec {
+    /// Walking if the steady forward speed exceeds this × √(gL).
+    pub walk_speed_threshold_over_sqrt_gl: f64,
+    /// Fallen if the hip point drops below this × L.
+    pub fall_hip_height_over_l: f64,
+    /// Fallen if |roll| of the hip frame exceeds this [deg].
+    pub fall_roll_deg: f64,
+    /// Fallen if |pitch| of the hip frame exceeds this [deg].
+    pub fall_pitch_deg: f64,
+}
+
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, Default)]
+#[serde(deny_unknown_fields)]
+pub struct GroundSpec {
+    /// Downhill slope along +x [deg] (0 = flat).
+    #[serde(default)]
+    pub slope_deg: f64,
+}
+
+/// A walker design (1× values of the robot it describes, SI units).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Design {
+    pub name: String,
+    #[serde(default)]
+    pub description: String,
+    pub geometry: Geometry,
+    pub mass: MassSpec,
+    pub contact: ContactSpec,
+    pub control: ControlSpec,
+    #[serde(default)]
+    pub hardstop: Option<HardstopSpec>,
+    pub initial: InitialSpec,
+    pub numerics: NumericsSpec,
+    pub criteria: CriteriaSpec,
+    #[serde(default)]
+    pub ground: GroundSpec,
+    #[serde(default)]
+    pub effects: Vec<EffectSpec>,
+}
+
+impl Design {
+    /// Parses and validates a design; `origin` (file name) appears in error messages.
+    pub fn from_toml_str(text: &str, origin: &str) -> Result<Design, SimError> {
+        let d: Design = toml::from_str(text).map_err(|e| SimError::Parse {
+            origin: origin.to_string(),
+            message: e.to_string(),
+        })?;
+        d.validate(origin)?;
+        Ok(d)
+    }
+
+    /// Reads a design file.
+    pub fn from_file(path: &Path) -> Result<Design, SimError> {
+        let text = std::fs::read_to_string(path).map_err(|source| SimError::Read {
+            path: path.to_path_buf(),
+            source,
+        })?;
+        Design::from_toml_str(&text, &path.display().to_string())
+    }
+
+    /// A bundled design by name (mugatu, zippy, zippy-spherical).
+    pub fn builtin(name: &str) -> Result<Design, SimError> {
+        let key = name.to_ascii_lowercase().replace('_', "-");
+        let key = if key == "zippy-ellipsoidal" {
+            "zippy".to_string()
+        } else {
+            key
+        };
+        for (n, text) in BUILTIN_DESIGNS {
+            if n == key {
+                return Design::from_toml_str(text, &format!("dataset/walkers/{n}.toml (bundled)"));
+            }
+        }
+        Err(SimError::UnknownDesign(name.to_string()))
+    }
+
+    /// A bundled name, or else a path to a TOML file.
+    pub fn resolve(name_or_path: &str) -> Result<Design, SimError> {
+        match Design::builtin(name_or_path) {
+            Ok(d) => Ok(d),
+            Err(SimError::UnknownDesign(_)) => {
+                let p = Path::new(name_or_path);
+                if p.exists() || name_or_path.ends_with(".toml") {
+                    Design::from_file(p)
+                } else {
+                    Err(SimError::UnknownDesign(name_or_path.to_string()))
+                }
+            }
+            Err(e) => Err(e),
+        }
+    }
+
+    fn validate(&self, origin: &str) -> Result<(), SimError> {
+        let check = |field: &str, v: f64, ok: bool, why: &str| -> Result<(), SimError> {
+            if ok && v.is_finite() {
+                Ok(())
+            } else {
+                Err(SimError::InvalidValue {
+                    origin: origin.to_string(),
+                    field: field.to_string(),
+                    value: v.to_string(),
+                    reason: why.to_string(),
+                })
+            }
+        };
+        let g = &self.geometry;
+        check(
+            "geometry.leg_length_m",
+            g.leg_length_m,
+            g.leg_length_m > 0.0,
+            "must be > 0",
+        )?;
+        check(
+            "geometry.body_length_m",
+            g.body_length_m,
+            g.body_length_m > 0.0,
+            "must be > 0",
+        )?;
+        for (i, a) in g.foot_semi_axes_m.iter().enumerate() {
+            check(
+                &format!("geometry.foot_semi_axes_m[{i}]"),
+                *a,
+                *a > 0.0,
+                "must be > 0",
+            )?;
+        }
+        check(
+            "geometry.hip_half_width_over_l",
+            g.hip_half_width_over_l,
+            g.hip_half_width_over_l >= 0.0,
+            "must be ≥ 0",
+        )?;
+        check(
+            "geometry.foot_center_lateral_over_l",
+            g.foot_center_lateral_over_l,
+            true,
+            "must be finite",
+        )?;
+        check(
+            "geometry.foot_center_forward_over_l",
+            g.foot_center_forward_over_l,
+            true,
+            "must be finite",
+        )?;
+        if let Some(c) = g.foot_section_cut_over_l {
+            check(
+                "geometry.foot_section_cut_over_l",
+                c,
+                c.abs() < 1.0,
+                "must be within ±1",
+            )?;
+        }
+        let m = &self.mass;
+        check(
+            "mass.total_mass_kg",
+            m.total_mass_kg,
+            m.total_mass_kg > 0.0,
+            "must be > 0",
+        )?;
+        check(
+            "mass.leg_com_height_over_l",
+            m.leg_com_height_over_l,
+            m.leg_com_height_over_l > 0.0 && m.leg_com_height_over_l < 1.0,
+            "must be in (0, 1)",
+        )?;
+        check(
+            "mass.leg_com_forward_over_l",
+            m.leg_com_forward_over_l,
+            true,
+            "must be finite",
+        )?;
+        for (i, b) in m.leg_inertia_box_over_l.iter().enumerate() {
+            check(
+                &format!("mass.leg_inertia_box_over_l[{i}]"),
+                *b,
+                *b > 0.0,
+                "must be > 0",
+            )?;
+        }
+        let c = &self.contact;
+        check(
+            "contact.hydroelastic_modulus_pa",
+            c.hydroelastic_modulus_pa,
+            c.hydroelastic_modulus_pa > 0.0,
+            "must be > 0",
+        )?;
+        check(
+            "contact.hunt_crossley_dissipation_s_per_m",
+            c.hunt_crossley_dissipation_s_per_m,
+            c.hunt_crossley_dissipation_s_per_m >= 0.0,
+            "must be ≥ 0",
+        )?;
+        check(
+            "contact.friction_mu",
+            c.friction_mu,
+            c.friction_mu >= 0.0,
+            "must be ≥ 0",
+        )?;
+        check(
+            "contact.stiction_speed_mps",
+            c.stiction_speed_mps,
+            c.stiction_speed_mps > 0.0,
+            "must be > 0",
+        )?;
+        match &self.control {
+            ControlSpec::ServoSine {
+                amplitude_deg,
+                frequency_hz,
+                kp_over_mgl,
+                kd_over_mgl_sqrt_l_over_g,
+                torque_limit_nm,
+            } => {
+                check(
+                    "control.amplitude_deg",
+                    *amplitude_deg,
+                    amplitude_deg.abs() < 90.0,
+                    "must be within ±90",
+                )?;
+                check(
+                    "control.frequency_hz",
+                    *frequency_hz,
+                    *frequency_hz > 0.0,
+                    "must be > 0",
+                )?;
+                check(
+                    "control.kp_over_mgl",
+                    *kp_over_mgl,
+                    *kp_over_mgl >= 0.0,
+                    "must be ≥ 0",
+                )?;
+                check(
+                    "control.kd_over_mgl_sqrt_l_over_g",
+                    *kd_over_mgl_sqrt_l_over_g,
+                    *kd_over_mgl_sqrt_l_over_g >= 0.0,
+                    "must be ≥ 0",
+                )?;
+                check(
+                    "control.torque_limit_nm",
+                    *torque_limit_nm,
+                    *torque_limit_nm >= 0.0,
+                    "must be ≥ 0",
+                )?;
+            }
+            ControlSpec::BangBang {
+                torque_nm,
+                frequency_hz,
+            } => {
+                check(
+                    "control.torque_nm",
+                    *torque_nm,
+                    *torque_nm >= 0.0,
+                    "must be ≥ 0",
+                )?;
+                check(
+                    "control.frequency_hz",
+                    *frequency_hz,
+                    *frequency_hz > 0.0,
+                    "must be > 0",
+                )?;
+            }
+        }
+        if let Some(h) = &self.hardstop {
+            check(
+                "hardstop.limit_deg",
+                h.limit_deg,
+                h.limit_deg > 0.0 && h.limit_deg < 180.0,
+                "must be in (0, 180)",
+            )?;
+            check(
+                "hardstop.stiffness_over_mgl",
+                h.stiffness_over_mgl,
+                h.stiffness_over_mgl > 0.0,
+                "must be > 0",
+            )?;
+            check(
+                "hardstop.damping_over_mgl_sqrt_l_over_g",
+                h.damping_over_mgl_sqrt_l_over_g,
+                h.damping_over_mgl_sqrt_l_over_g >= 0.0,
+                "must be ≥ 0",
+            )?;
+        }
+        let i = &self.initial;
+        check(
+            "initial.roll_deg",
+            i.roll_deg,
+            i.roll_deg.abs() < 45.0,
+            "must be within ±45",
+        )?;
+        check(
+            "initial.seed_angle_sd_deg",
+            i.seed_angle_sd_deg,
+            i.seed_angle_sd_deg >= 0.0,
+            "must be ≥ 0",
+        )?;
+        check(
+            "initial.seed_rate_sd_over_sqrt_g_over_l",
+            i.seed_rate_sd_over_sqrt_g_over_l,
+            i.seed_rate_sd_over_sqrt_g_over_l >= 0.0,
+            "must be ≥ 0",
+        )?;
+        check(
+            "numerics.time_step_s",
+            self.numerics.time_step_s,
+            self.numerics.time_step_s > 0.0,
+            "must be > 0",
+        )?;
+        let k = &self.criteria;
+        check(
+            "criteria.walk_speed_threshold_over_sqrt_gl",
+            k.walk_speed_threshold_over_sqrt_gl,
+            k.walk_speed_threshold_over_sqrt_gl >= 0.0,
+            "must be ≥ 0",
+        )?;
+        check(
+            "criteria.fall_hip_height_over_l",
+            k.fall_hip_height_over_l,
+            k.fall_hip_height_over_l > 0.0,
+            "must be > 0",
+        )?;
+        check(
+            "criteria.fall_roll_deg",
+            k.fall_roll_deg,
+            k.fall_roll_deg > 0.0,
+            "must be > 0",
+        )?;
+        check(
+            "criteria.fall_pitch_deg",
+            k.fall_pitch_deg,
+            k.fall_pitch_deg > 0.0,
+            "must be > 0",
+        )?;
+        check(
+            "ground.slope_deg",
+            self.ground.slope_deg,
+            self.ground.slope_deg.abs() < 45.0,
+            "must be within ±45",
+        )?;
+        for (n, e) in self.effects.iter().enumerate() {
+            e.validate(origin, &format!("effects[{n}]"))?;
+        }
+        Ok(())
+    }
+
+    pub fn leg_length_m(&self) -> f64 {
+        self.geometry.leg_length_m
+    }
+
+    /// m·g·L [N·m], the natural torque unit of the design.
+    pub fn mgl_nm(&self) -> f64 {
+        self.mass.total_mass_kg * GRAVITY_MPS2 * self.geometry.leg_length_m
+    }
+
+    /// The design scaled to leg length `leg_length_m`: lengths ∝ L, mass ∝ L² or L³
+    /// (inertia ∝ m·L² follows from the box fractions), frequencies ∝ L^(−1/2), torques
+    /// ∝ m·L, time step ∝ L^(1/2), contact by `contact_scaling`.
+    pub fn scaled(
+        &self,
+        leg_length_m: f64,
+        mass_law: MassLaw,
+        contact_scaling: ContactScaling,
+    ) -> Result<Design, SimError> {
+        if !(leg_length_m > 0.0 && leg_length_m.is_finite()) {
+            return Err(SimError::InvalidOption {
+                option: "leg_length_m".into(),
+                reason: format!("must be finite and > 0, got {leg_length_m}"),
+            });
+        }
+        let s = leg_length_m / self.geometry.leg_length_m;
+        let mu = s.powf(mass_law.exponent());
+        let time = s.sqrt();
+        let mut d = self.clone();
+        d.geometry.leg_length_m *= s;
+        d.geometry.body_length_m *= s;
+        for a in d.geometry.foot_semi_axes_m.iter_mut() {
+            *a *= s;
+        }
+        d.mass.total_mass_kg *= mu;
+        match contact_scaling {
+            ContactScaling::Similar => {
+                d.contact.hydroelastic_modulus_pa *= mu / (s * s);
+                d.contact.hunt_crossley_dissipation_s_per_m /= time;
+            }
+            ContactScaling::FixedMaterial => {}
+        }
+        // Numerical regularisation, not a material property: keep it a fixed fraction of √(gL).
+        d.contact.stiction_speed_mps *= time;
+        match &mut d.control {
+            ControlSpec::ServoSine {
+                frequency_hz,
+                torque_limit_nm,
+                ..
+            } => {
+                *frequency_hz /= time;
+                *torque_limit_nm *= mu * s;
+            }
+            ControlSpec::BangBang {
+                torque_nm,
+                frequency_hz,
+            } => {
+                *frequency_hz /= time;
+                *torque_nm *= mu * s;
+            }
+        }
+        d.numerics.time_step_s *= time;
+        for e in d.effects.iter_mut() {
+            *e = e.scaled(s, mu);
+        }
+        Ok(d)
+    }
+
+    /// The rigid-body model.
+    pub fn model(&self) -> Model {
+        let l = self.geometry.leg_length_m;
+        let g = &self.geometry;
+        let m = &self.mass;
+        let leg_mass = 0.5 * m.total_mass_kg;
+        let b = m.leg_inertia_box_over_l.map(|x| x * l);
+        let inertia = Matrix3::from_diagonal(&Vector3::new(
+            leg_mass / 12.0 * (b[1] * b[1] + b[2] * b[2]),
+            leg_mass / 12.0 * (b[0] * b[0] + b[2] * b[2]),
+            leg_mass / 12.0 * (b[0] * b[0] + b[1] * b[1]),
+        ));
+        let semi = Vector3::new(
+            g.foot_semi_axes_m[0],
+            g.foot_semi_axes_m[1],
+            g.foot_semi_axes_m[2],
+        );
+        let leg = |side: f64| Leg {
+            mass_kg: leg_mass,
+            com_m: Vector3::new(
+                m.leg_com_forward_over_l * l,
+                side * g.hip_half_width_over_l * l,
+                -(1.0 - m.leg_com_height_over_l) * l,
+            ),
+            inertia_com_kgm2: inertia,
+            foot_center_m: Vector3::new(
+                g.foot_center_forward_over_l * l,
+                side * g.foot_center_lateral_over_l * l,
+                -l + semi.z,
+            ),
+            foot_semi_axes_m: semi,
+            foot_section: g.foot_section_cut_over_l.map(|c| FootSection {
+                normal: Vector3::new(0.0, side, 0.0),
+                offset_m: c * l,
+            }),
+        };
+        let mgl = self.mgl_nm();
+        let tl = (l / GRAVITY_MPS2).sqrt();
+        let slope = self.ground.slope_deg.to_radians();
+        Model {
+            legs: [leg(1.0), leg(-1.0)],
+            contact: ContactParams {
+                modulus_pa: self.contact.hydroelastic_modulus_pa,
+                dissipation_s_per_m: self.contact.hunt_crossley_dissipation_s_per_m,
+                friction_mu: self.contact.friction_mu,
+                stiction_speed_mps: self.contact.stiction_speed_mps,
+            },
+            hardstop: self.hardstop.as_ref().map(|h| Hardstop {
+                limit_rad: h.limit_deg.to_radians(),
+                stiffness_nm_per_rad: h.stiffness_over_mgl * mgl,
+                damping_nms_per_rad: h.damping_over_mgl_sqrt_l_over_g * mgl * tl,
+            }),
+            gravity_mps2: Vector3::new(slope.sin(), 0.0, -slope.cos()) * GRAVITY_MPS2,
+            ground_contact: true,
+        }
+    }
+
+    /// The hip controller.
+    pub fn controller(&self) -> Controller {
+        let mgl = self.mgl_nm();
+        let tl = (self.geometry.leg_length_m / GRAVITY_MPS2).sqrt();
+        match self.control {
+            ControlSpec::ServoSine {
+                amplitude_deg,
+                frequency_hz,
+                kp_over_mgl,
+                kd_over_mgl_sqrt_l_over_g,
+                torque_limit_nm,
+            } => Controller::ServoSine {
+                amplitude_rad: amplitude_deg.to_radians(),
+                frequency_hz,
+                kp_nm_per_rad: kp_over_mgl * mgl,
+                kd_nms_per_rad: kd_over_mgl_sqrt_l_over_g * mgl * tl,
+                torque_limit_nm,
+            },
+            ControlSpec::BangBang {
+                torque_nm,
+                frequency_hz,
+            } => Controller::BangBang {
+                torque_nm,
+                frequency_hz,
+            },
+        }
+    }
+
+    /// Initial state: at rest, legs together, rolled `initial.roll_deg` onto the right foot,
+    /// standing on the ground with the static sinkage of one foot carrying the whole weight.
+    /// A seed perturbs roll, pitch, yaw and the angular velocity deterministically (ChaCha8).
+    pub fn initial_state(&self, model: &Model, seed: Option<u64>) -> State {
+        let l = self.geometry.leg_length_m;
+        let mut roll = self.initial.roll_deg.to_radians();
+        let mut pitch = 0.0;
+        let mut yaw = 0.0;
+        let mut omega = Vector3::zeros();
+        if let Some(seed) = seed {
+            let mut rng = ChaCha8Rng::seed_from_u64(seed);
+            // Uniform on ±√3·sd has standard deviation sd.
+            let a = self.initial.seed_angle_sd_deg.to_radians() * 3f64.sqrt();
+            let w = self.initial.seed_rate_sd_over_sqrt_g_over_l
+                * (GRAVITY_MPS2 / l).sqrt()
+                * 3f64.sqrt();
+            let mut u = |x: f64| {
+                if x > 0.0 {
+                    rng.random_range(-x..x)
+                } else {
+                    0.0
+                }
+            };
+            roll += u(a);
+            pitch += u(a);
+            yaw += u(a);
+            omega = Vector3::new(u(w), u(w), u(w));
+        }
+        let orientation = UnitQuaternion::from_euler_angles(roll, pitch, yaw);
+        let r = *orientation.to_rotation_matrix().matrix();
+        let weight = model.total_mass_kg() * GRAVITY_MPS2;
+        let sink = (weight / (std::f64::consts::PI * model.contact.modulus_pa)).sqrt();
+        // Lowest height of the hip for which each foot just touches; take the highest.
+        let mut hip_z = f64::NEG_INFINITY;
+        for leg in &model.legs {
+            let nf = r.transpose() * Vector3::z();
+            let a = leg.foot_semi_axes_m;
+            let support =
+                (a.x * a.x * nf.x * nf.x + a.y * a.y * nf.y * nf.y + a.z * a.z * nf.z * nf.z)
+                    .sqrt();
+            let z = support - (r * leg.foot_center_m).z;
+            hip_z = hip_z.max(z);
+        }
+        State {
+            hip_position_m: Vector3::new(0.0, 0.0, hip_z - sink),
+            orientation,
+            hip_angle_rad: 0.0,
+            hip_velocity_mps: Vector3::zeros(),
+            angular_velocity_rad_s: omega,
+            hip_rate_rad_s: 0.0,
+        }
+    }
+}

@@ -1,0 +1,41 @@
+//! 3D simulation of quasi-passive hip-actuated bipeds (Mugatu, Zippy) for the scaling study
+//! of Sections IV–V of "Allometric Scaling Laws for Bipedal Robots".
+//!
+//! * [`model`]: two rigid legs, one lateral hip joint, floating base (7 DOF, reduced
+//!   coordinates), full 3D rigid-body dynamics, linearly implicit Euler integrator.
+//! * [`contact`]: pressure-field (hydroelastic) contact of ellipsoidal feet on a rigid plane,
+//!   closed-form normal force / centre of pressure / rolling resistance, patch-integrated
+//!   regularised Coulomb friction with torsional moment.
+//! * [`control`]: position servo (Mugatu) and bang-bang torque with hardstops (Zippy).
+//! * [`design`]: designs as TOML data, scaling with leg length.
+//! * [`effects`]: optional physical effects (hip damping, …) as data-described plug-ins.
+//! * [`walk`]: running a walk and its gait metrics ([`WalkReport`]).
+//! * [`plot`]: SVG plot of a walk.
+//!
+//! Self-contained: depends only on external crates and std.
+
+pub mod contact;
+pub mod control;
+pub mod design;
+pub mod effects;
+pub mod error;
+pub mod model;
+pub mod plot;
+pub mod walk;
+
+pub use contact::{
+    ContactParams, Cut, Patch, PatchWrench, patch, patch_forces, patch_into, patch_wrench,
+};
+pub use control::{Command, Controller};
+pub use design::{BUILTIN_DESIGNS, ContactScaling, Design, GRAVITY_MPS2, MassLaw};
+pub use effects::{Effect, EffectContext, EffectFile, EffectSpec, GeneralizedForce};
+pub use error::SimError;
+pub use model::{
+    Energy, FootSection, Hardstop, Kinematics, Leg, Matrix7, Model, Simulator, State, StepInfo,
+    Vector7,
+};
+pub use plot::{render_svg, write_plot_svg};
+pub use walk::{
+    TrajectorySample, WalkOptions, WalkReport, WalkResult, WalkSetup, hip_frame_attitude,
+    prepare_walk, run_setup, simulate_walk, walks_with_torque_limit, write_trajectory_csv,
+};

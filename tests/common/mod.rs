@@ -1,0 +1,72 @@
+//! Helpers shared by the integration tests.
+#![allow(dead_code)]
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+pub fn repo() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+}
+
+/// `../shared/upstream/robot-dataset/` beside the checkout (CI puts shared/ there).
+pub fn upstream_dir() -> PathBuf {
+    repo().join("../shared/upstream/robot-dataset")
+}
+
+pub fn upstream_csv() -> PathBuf {
+    upstream_dir().join("robot_scaling_dataset.csv")
+}
+
+/// Runs the real `survey` binary.
+pub fn survey(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_survey"))
+        .args(args)
+        .current_dir(repo())
+        .output()
+        .expect("the survey binary runs")
+}
+
+pub fn stdout(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stdout).into_owned()
+}
+
+pub fn stderr(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stderr).into_owned()
+}
+
+/// A scratch dataset: the repo's dataset.toml, vocabulary.toml and datapackage.json, and
+/// the given record files under robots/.
+pub fn scratch_dataset(records: &[&Path]) -> tempfile::TempDir {
+    let dir = tempfile::tempdir().expect("tempdir");
+    for f in ["dataset.toml", "vocabulary.toml", "datapackage.json"] {
+        std::fs::copy(repo().join("dataset").join(f), dir.path().join(f))
+            .expect("copy dataset metadata");
+    }
+    std::fs::create_dir_all(dir.path().join("robots")).expect("robots dir");
+    for r in records {
+        let name = r.file_name().expect("file name");
+        std::fs::copy(r, dir.path().join("robots").join(name)).expect("copy record");
+    }
+    dir
+}
+
+/// Copies a whole directory tree.
+pub fn copy_tree(from: &Path, to: &Path) {
+    std::fs::create_dir_all(to).expect("mkdir");
+    for e in std::fs::read_dir(from).expect("read_dir") {
+        let e = e.expect("entry");
+        let p = e.path();
+        if p.is_dir() {
+            copy_tree(&p, &to.join(e.file_name()));
+        } else {
+            std::fs::copy(&p, to.join(e.file_name())).expect("copy");
+        }
+    }
+}
+
+/// A full copy of the repo's dataset in a temp dir.
+pub fn dataset_copy() -> tempfile::TempDir {
+    let dir = tempfile::tempdir().expect("tempdir");
+    copy_tree(&repo().join("dataset"), dir.path());
+    dir
+}

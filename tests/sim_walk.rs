@@ -1,0 +1,189 @@
+//! Gait tests of the bundled walker designs against the paper's Drake results
+//! (Oke et al., Table IV, m ∝ L²): each design walks steadily forward at 1× with body
+//! attitude amplitudes of the paper's magnitude (bands: a factor 2 either way) and a
+//! Froude number v/√(gL) in 0.05–0.7; scaled Mugatus walk and v ∝ L^½.
+//!
+//! Known gaps are kept as `#[ignore]`d tests stating what fails (run them with
+//! `cargo test -- --ignored`), rather than loosened bands.
+
+use robot_survey::sim::{ContactScaling, Design, MassLaw, WalkOptions, WalkReport, simulate_walk};
+
+fn walk(name: &str, opts: WalkOptions) -> WalkReport {
+    let d = Design::builtin(name).expect("bundled design");
+    let opts = WalkOptions {
+        record_trajectory: false,
+        ..opts
+    };
+    simulate_walk(&d, &opts).expect("walk runs").report
+}
+
+/// `value` within a factor `k` of `paper`.
+fn within_factor(what: &str, value: f64, paper: f64, k: f64) {
+    assert!(
+        value >= paper / k && value <= paper * k,
+        "{what} = {value:.2}, paper {paper:.2} (allowed ×1/{k}–×{k})"
+    );
+}
+
+fn assert_walks_steadily(r: &WalkReport) {
+    assert!(r.walks, "does not walk: {r:?}");
+    assert!(r.fall_reason.is_none(), "fell: {r:?}");
+    assert!(
+        r.converged_at_s.is_some(),
+        "no limit cycle found on the Poincaré section: {r:?}"
+    );
+    assert!(
+        (0.05..=0.7).contains(&r.froude),
+        "Froude v/√(gL) = {:.3} outside 0.05–0.7",
+        r.froude
+    );
+}
+
+#[test]
+fn mugatu_walks_at_1x_like_the_paper() {
+    let r = walk("mugatu", WalkOptions::default());
+    assert_walks_steadily(&r);
+    within_factor("roll p-p [deg]", r.roll_pp_deg, 19.91, 2.0);
+    within_factor("pitch p-p [deg]", r.pitch_pp_deg, 10.83, 2.0);
+    within_factor("yaw p-p [deg]", r.yaw_pp_deg, 10.06, 2.0);
+    // Since the leg inertia fix (dataset/walkers/mugatu.toml) all three match to 25 %
+    // (measured 18.6 / 10.6 / 9.2 deg).
+    within_factor("roll p-p [deg]", r.roll_pp_deg, 19.91, 1.25);
+    within_factor("pitch p-p [deg]", r.pitch_pp_deg, 10.83, 1.25);
+    within_factor("yaw p-p [deg]", r.yaw_pp_deg, 10.06, 1.25);
+    // Steady: cycle-to-cycle spread small against the amplitude.
+    assert!(r.roll_pp_deg_sd < 0.2 * r.roll_pp_deg && r.pitch_pp_deg_sd < 0.2 * r.pitch_pp_deg);
+    // Hardware speed 0.16 m/s [robot-dataset]; one step per leg per drive cycle.
+    within_factor("velocity [m/s]", r.velocity_mps, 0.16, 1.5);
+    within_factor(
+        "step frequency [Hz]",
+        r.step_frequency_hz,
+        2.0 * r.drive_frequency_hz,
+        1.1,
+    );
+    assert!(r.peak_torque_nm > 0.0 && r.cot > 0.0 && r.mechanical_work_j > 0.0);
+}
+
+#[test]
+fn zippy_walks_at_1x() {
+    let r = walk("zippy", WalkOptions::default());
+    assert_walks_steadily(&r);
+    within_factor("roll p-p [deg]", r.roll_pp_deg, 9.28, 2.0);
+    within_factor("pitch p-p [deg]", r.pitch_pp_deg, 25.02, 2.0);
+}
+
+/// The yaw oscillation of the ellipsoidal Zippy (paper 7.14 deg p-p). It was ~55 deg before
+/// the design got its motor torque–speed line, hip-height COM and near-resonant drive (see
+/// dataset/walkers/zippy.toml); also checked from seeded initial states.
+#[test]
+fn zippy_yaw_like_the_paper() {
+    for seed in [None, Some(1), Some(2)] {
+        let r = walk(
+            "zippy",
+            WalkOptions {
+                seed,
+                ..WalkOptions::default()
+            },
+        );
+        assert_walks_steadily(&r);
+        within_factor("yaw p-p [deg]", r.yaw_pp_deg, 7.14, 2.0);
+    }
+}
+
+#[test]
+fn zippy_spherical_walks_at_1x() {
+    let r = walk("zippy-spherical", WalkOptions::default());
+    assert_walks_steadily(&r);
+    within_factor("roll p-p [deg]", r.roll_pp_deg, 16.27, 2.0);
+    within_factor("pitch p-p [deg]", r.pitch_pp_deg, 25.02, 2.0);
+    within_factor("yaw p-p [deg]", r.yaw_pp_deg, 7.45, 2.0);
+}
+
+#[test]
+fn scaled_mugatu_walks_with_both_mass_laws() {
+    for law in [MassLaw::L2, MassLaw::L3] {
+        let r = walk(
+            "mugatu",
+            WalkOptions {
+                leg_length_m: Some(0.5),
+                mass_law: law,
+                ..WalkOptions::default()
+            },
+        );
+        assert_walks_steadily(&r);
+        within_factor("roll p-p [deg]", r.roll_pp_deg, 19.91, 2.0);
+    }
+}
+
+/// Least-squares slope of ln y against ln x.
+fn log_log_slope(pts: &[(f64, f64)]) -> f64 {
+    let n = pts.len() as f64;
+    let (lx, ly): (Vec<f64>, Vec<f64>) = pts.iter().map(|p| (p.0.ln(), p.1.ln())).unzip();
+    let mx = lx.iter().sum::<f64>() / n;
+    let my = ly.iter().sum::<f64>() / n;
+    lx.iter()
+        .zip(&ly)
+        .map(|(x, y)| (x - mx) * (y - my))
+        .sum::<f64>()
+        / lx.iter().map(|x| (x - mx).powi(2)).sum::<f64>()
+}
+
+/// Dynamic similarity (f ∝ L^−½, similar contact): v ∝ L^½. Least-squares exponent over
+/// L = 0.05, 0.153, 0.5 m must be 0.5 ± 0.05 (paper: 0.50, R² = 1.000).
+#[test]
+fn mugatu_velocity_scales_as_sqrt_leg_length() {
+    let pts: Vec<(f64, f64)> = [0.05, 0.153, 0.5]
+        .iter()
+        .map(|&l| {
+            let r = walk(
+                "mugatu",
+                WalkOptions {
+                    leg_length_m: Some(l),
+                    ..WalkOptions::default()
+                },
+            );
+            assert!(r.walks, "L = {l} m does not walk");
+            (l, r.velocity_mps)
+        })
+        .collect();
+    let b = log_log_slope(&pts);
+    assert!((b - 0.5).abs() < 0.05, "velocity exponent {b:.3}");
+}
+
+/// A real robot's foot material (fixed modulus and damping, m ∝ L²: the sinkage stays the
+/// same fraction of L, only the Hunt–Crossley damping is relatively stronger when small):
+/// Mugatu still walks from L = 0.05 to 1.0 m with v ∝ L^½ (measured 0.512) and the peak hip
+/// torque ∝ m·L (measured exponent 0.965). Bands ± 0.05 / ± 0.1.
+#[test]
+fn mugatu_fixed_material_m_l2_scales_like_froude() {
+    let runs: Vec<WalkReport> = [0.05, 0.153, 0.5, 1.0]
+        .iter()
+        .map(|&l| {
+            let r = walk(
+                "mugatu",
+                WalkOptions {
+                    leg_length_m: Some(l),
+                    contact_scaling: ContactScaling::FixedMaterial,
+                    ..WalkOptions::default()
+                },
+            );
+            assert!(r.walks, "L = {l} m does not walk: {r:?}");
+            r
+        })
+        .collect();
+    let v: Vec<(f64, f64)> = runs
+        .iter()
+        .map(|r| (r.leg_length_m, r.velocity_mps))
+        .collect();
+    let b = log_log_slope(&v);
+    assert!((b - 0.5).abs() < 0.05, "velocity exponent {b:.3}");
+    let t: Vec<(f64, f64)> = runs
+        .iter()
+        .map(|r| (r.mass_kg * r.leg_length_m, r.peak_torque_nm))
+        .collect();
+    let bt = log_log_slope(&t);
+    assert!(
+        (bt - 1.0).abs() < 0.1,
+        "peak torque exponent vs m·L {bt:.3}"
+    );
+}
