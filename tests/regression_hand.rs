@@ -506,8 +506,52 @@ fn xy_strategy() -> impl Strategy<Value = (Vec<f64>, Vec<f64>)> {
     })
 }
 
+/// Regression: the MA slope of a shallow line lost digits to cancellation in
+/// (Syy − Sxx) + √((Syy − Sxx)² + 4Sxy²) (CI, fresh machine, swap property test).
+/// On the exact line y = 1e-6·x every fitting method must return 1e-6: the old
+/// formula gave a relative error near ε/b² ≈ 1e-4.
+#[test]
+fn ma_slope_of_a_shallow_line_keeps_its_digits() {
+    let x = [-100.0, -50.0, 0.0, 25.0, 50.0, 100.0];
+    let y: Vec<f64> = x.iter().map(|v| 1e-6 * v).collect();
+    for method in [Method::Ols, Method::Sma, Method::Ma] {
+        let f = fit_line(&x, &y, method, 0.95).unwrap();
+        close(f.b, 1e-6, 1e-6 * 1e-10);
+        let swapped = fit_line(&y, &x, method, 0.95);
+        if method != Method::Ols {
+            close(swapped.unwrap().b, 1e6, 1e6 * 1e-10);
+        }
+    }
+    // With scatter the MA interval of the shallow line still brackets its estimate,
+    // and swapping x and y gives the reciprocal interval (Warton et al. 2006, MA is symmetric).
+    let y: Vec<f64> = x
+        .iter()
+        .zip([1.0, -1.0, 0.5, -0.5, 1.0, -1.0])
+        .map(|(v, e)| 1e-4 * v + 1e-4 * e)
+        .collect();
+    let xy = fit_line(&x, &y, Method::Ma, 0.95).unwrap();
+    let yx = fit_line(&y, &x, Method::Ma, 0.95).unwrap();
+    close(xy.b * yx.b, 1.0, 1e-12);
+    assert!(xy.b_ci.lower < xy.b && xy.b < xy.b_ci.upper);
+    close(xy.b_ci.lower * yx.b_ci.upper, 1.0, 1e-9);
+    close(xy.b_ci.upper * yx.b_ci.lower, 1.0, 1e-9);
+}
+
+/// Property tests run on a fixed seed so CI is reproducible bit for bit; set
+/// `PROPTEST_RNG_SEED=N` (and `PROPTEST_CASES`) to explore other samples locally.
+/// (A random seed on a fresh CI machine once found the MA cancellation bug (regression_hand.rs) —
+/// worth exploring, not worth a flaky CI.)
+fn reproducible(cases: u32) -> ProptestConfig {
+    let mut config = ProptestConfig::with_cases(cases);
+    if config.rng_seed == proptest::test_runner::RngSeed::Random {
+        config.rng_seed = proptest::test_runner::RngSeed::Fixed(20_261_123);
+    }
+    config.failure_persistence = None;
+    config
+}
+
 proptest! {
-    #![proptest_config(ProptestConfig::with_cases(200))]
+    #![proptest_config(reproducible(200))]
 
     /// OLS slope from faer's QR solve equals the closed form Sxy/Sxx.
     #[test]

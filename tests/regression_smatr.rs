@@ -171,6 +171,34 @@ fn animals_ma_matches_line_cis() {
     assert!(!f.b_ci_inverted);
 }
 
+/// An MA interval that contains the vertical: setosa log10 petal length (x) against
+/// 3·log10 sepal width (y), weakly correlated (r = 0.181) with Var(y) ≫ Var(x).
+/// line.cis returns lower > upper, meaning the slopes [5.18, +∞) ∪ (−∞, −23.25];
+/// swapping the axes turns it into the ordinary interval of the reciprocal.
+#[test]
+fn iris_ma_interval_through_the_vertical_matches_line_cis() {
+    let rows = 0..50;
+    let x: Vec<f64> = PETAL_LENGTH[rows.clone()]
+        .iter()
+        .map(|v| v.log10())
+        .collect();
+    let y: Vec<f64> = SEPAL_WIDTH[rows].iter().map(|v| 3.0 * v.log10()).collect();
+    let f = fit_line(&x, &y, Method::Ma, 0.95).unwrap();
+    // line.cis(y, x, method = "MA")
+    close(f.intercept, -0.59329977618571, TIGHT);
+    close(f.b, 13.5307114274395, TIGHT);
+    close(f.b_ci.lower, 5.18497897711229, TIGHT);
+    close(f.b_ci.upper, -23.2513115241534, TIGHT);
+    close(f.se_b, 10.5923028204975, TIGHT);
+    assert!(f.b_ci_inverted);
+    // line.cis(x, y, method = "MA")
+    let swapped = fit_line(&y, &x, Method::Ma, 0.95).unwrap();
+    close(swapped.b, 0.0739059439233961, TIGHT);
+    close(swapped.b_ci.lower, -0.0430083266039083, TIGHT);
+    close(swapped.b_ci.upper, 0.192864812839982, TIGHT);
+    assert!(!swapped.b_ci_inverted);
+}
+
 #[test]
 fn animals_ols_matches_line_cis_and_lm() {
     let (x, y) = animals_log();

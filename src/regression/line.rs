@@ -90,8 +90,9 @@ pub struct LineFit {
     pub b_ci: Interval,
     /// Standard error of the slope (smatr's `sqrt(var.b)`).
     pub se_b: f64,
-    /// MA only: the interval contains the vertical (the Y axis). The actual
-    /// region is then `[b_ci.upper, +∞) ∪ (−∞, b_ci.lower]`, as smatr warns.
+    /// MA only: the interval contains the vertical (the Y axis). `b_ci.lower` is
+    /// then above `b_ci.upper` and the actual region is
+    /// `[b_ci.lower, +∞) ∪ (−∞, b_ci.upper]`, as smatr warns.
     pub b_ci_inverted: bool,
     /// Intercept (elevation).
     pub intercept: f64,
@@ -172,8 +173,17 @@ pub(crate) fn slope_from_moments(m: &Moments, method: Method) -> Result<f64, Reg
             if m.sxy == 0.0 {
                 return Err(RegressionError::ZeroCovariance { method: "MA" });
             }
+            // b = (fac + s) / 2Sxy with s = √(fac² + 4Sxy²). When Syy < Sxx (a shallow line)
+            // fac + s cancels catastrophically; the conjugate form 2Sxy / (s − fac) is the
+            // same number without the cancellation (found by the swap property test:
+            // b ≈ 1e-4 lost five digits).
             let fac = m.syy - m.sxx;
-            Ok((fac + (fac * fac + 4.0 * m.sxy * m.sxy).sqrt()) / (2.0 * m.sxy))
+            let s = (fac * fac + 4.0 * m.sxy * m.sxy).sqrt();
+            if fac >= 0.0 {
+                Ok((fac + s) / (2.0 * m.sxy))
+            } else {
+                Ok(2.0 * m.sxy / (s - fac))
+            }
         }
     }
 }
@@ -243,7 +253,12 @@ pub(crate) fn fit_from_moments(
                     upper: f64::INFINITY,
                 }
             } else {
-                let num = fac + disc.sqrt();
+                // fac + √disc, in the conjugate form when fac < 0 (see slope_from_moments).
+                let num = if fac >= 0.0 {
+                    fac + disc.sqrt()
+                } else {
+                    4.0 * (m.sxy * m.sxy - q) / (disc.sqrt() - fac)
+                };
                 let lower = num / 2.0 / (m.sxy + q.sqrt());
                 let upper = num / 2.0 / (m.sxy - q.sqrt());
                 if q > m.sxy * m.sxy && fac > 0.0 {
