@@ -99,6 +99,48 @@ fn zippy_spherical_walks_at_1x() {
     within_factor("yaw p-p [deg]", r.yaw_pp_deg, 7.45, 2.0);
 }
 
+/// A period-1 gait transfers support once per half drive period (one step per leg swing),
+/// so the step frequency counted from the feet's normal loads is twice the drive frequency.
+/// For the bang-bang Zippys this is the hardstop-to-hardstop swing.
+#[test]
+fn steps_lock_to_the_drive() {
+    for name in ["mugatu", "zippy", "zippy-spherical"] {
+        let r = walk(name, WalkOptions::default());
+        assert_walks_steadily(&r);
+        within_factor(
+            &format!("{name} step frequency [Hz]"),
+            r.step_frequency_hz,
+            2.0 * r.drive_frequency_hz,
+            1.02,
+        );
+    }
+}
+
+/// Vertical momentum balance: over a limit cycle the body neither rises nor sinks, so the
+/// time-averaged normal load of the two feet equals the weight m·g (flat ground).
+#[test]
+fn feet_carry_the_weight_on_average() {
+    for name in ["mugatu", "zippy"] {
+        let d = Design::builtin(name).expect("bundled design");
+        let out = simulate_walk(&d, &WalkOptions::default()).expect("walk runs");
+        let r = &out.report;
+        assert_walks_steadily(r);
+        let t0 = r.converged_at_s.expect("converged");
+        let window: Vec<f64> = out
+            .trajectory
+            .iter()
+            .filter(|s| s.t_s >= t0)
+            .map(|s| s.normal_force_n[0] + s.normal_force_n[1])
+            .collect();
+        let mean = window.iter().sum::<f64>() / window.len() as f64;
+        let weight = r.mass_kg * 9.81;
+        assert!(
+            (mean / weight - 1.0).abs() < 0.01,
+            "{name}: mean normal load {mean:.4} N vs weight {weight:.4} N"
+        );
+    }
+}
+
 #[test]
 fn scaled_mugatu_walks_with_both_mass_laws() {
     for law in [MassLaw::L2, MassLaw::L3] {

@@ -218,6 +218,8 @@ pub struct StepInfo {
     pub actuator_torque_nm: f64,
     /// Number of feet in contact.
     pub feet_in_contact: u8,
+    /// Normal contact force on each foot, [left, right] [N] (0 when off the ground).
+    pub normal_force_n: [f64; 2],
 }
 
 impl Model {
@@ -496,6 +498,7 @@ impl Simulator {
             let ja = Model::angular_jacobian(k, &kin);
             let v_cop = jp * nu;
             let wr = contact::patch_wrench(p, &model.contact, &v_cop, &kin.omega_w[k]);
+            info.normal_force_n[k] = wr.force.z.max(0.0);
             Model::add_wrench(&mut tau, k, &kin, &r, &wr.force, &wr.moment);
             // Normal: damping plus h × stiffness (implicit in position along the normal).
             let cn = wr.normal_damping + h * p.stiffness_n_per_m;

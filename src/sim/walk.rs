@@ -8,7 +8,10 @@ use serde::Serialize;
 
 use super::design::{ContactScaling, Design, GRAVITY_MPS2, MassLaw};
 use super::error::SimError;
-use super::model::{Model, Simulator, State};
+use super::model::{Model, Simulator, State, StepInfo};
+
+/// Share of the normal load a foot must carry to become the stance foot (step counting).
+const STANCE_LOAD_SHARE: f64 = 0.75;
 
 /// Options of a walk (defaults: design's own size, m ∝ L², similar contact, 25 s, no seed).
 #[derive(Clone, Debug, PartialEq)]
@@ -63,6 +66,8 @@ pub struct TrajectorySample {
     /// Cumulative positive actuator work [J].
     pub positive_work_j: f64,
     pub feet_in_contact: u8,
+    /// Normal contact force on each foot at this instant, [left, right] [N].
+    pub normal_force_n: [f64; 2],
 }
 
 /// Gait metrics of a walk (NaN → JSON null where undefined, e.g. after an early fall).
@@ -94,6 +99,8 @@ pub struct WalkReport {
     pub velocity_mps: f64,
     /// v/√(gL).
     pub froude: f64,
+    /// Support transfers per second over the window: a step is counted when the other foot
+    /// takes over three quarters of the normal load.
     pub step_frequency_hz: f64,
     pub roll_pp_deg: f64,
     pub roll_pp_deg_sd: f64,
@@ -208,7 +215,7 @@ pub fn run_setup(setup: &mut WalkSetup, opts: &WalkOptions) -> Result<WalkResult
                     torque: f64,
                     peak: f64,
                     work: f64,
-                    feet: u8,
+                    info: &StepInfo,
                     samples: &mut Vec<TrajectorySample>| {
         let s = &sim.state;
         let (roll, pitch, yaw) = hip_frame_attitude(&sim.model, s);
@@ -228,10 +235,11 @@ pub fn run_setup(setup: &mut WalkSetup, opts: &WalkOptions) -> Result<WalkResult
             hip_torque_nm: torque,
             peak_abs_torque_nm: peak,
             positive_work_j: work,
-            feet_in_contact: feet,
+            feet_in_contact: info.feet_in_contact,
+            normal_force_n: info.normal_force_n,
         });
     };
-    push(sim, 0.0, 0.0, 0.0, 0, &mut samples);
+    push(sim, 0.0, 0.0, 0.0, &StepInfo::default(), &mut samples);
     for i in 1..=steps {
         let info = sim.step();
         let torque = info.actuator_torque_nm;
@@ -242,7 +250,7 @@ pub fn run_setup(setup: &mut WalkSetup, opts: &WalkOptions) -> Result<WalkResult
                 fall = Some(("diverged".into(), sim.time_s));
                 break;
             }
-            push(sim, torque, peak, work, info.feet_in_contact, &mut samples);
+            push(sim, torque, peak, work, &info, &mut samples);
             peak = 0.0;
             let last = samples[samples.len() - 1];
             let reason = if last.z_m < crit.fall_hip_height_over_l * l {
@@ -468,25 +476,25 @@ fn analyze(
     } else {
         nan
     };
-    // Steps: side changes of roll about its window mean (one per step), with a hysteresis
-    // of a quarter of the roll half-amplitude so contact chatter is not counted.
-    let roll_mean = win.iter().map(|s| s.roll_deg).sum::<f64>() / win.len() as f64;
-    let band = 0.125 * r.roll_pp_deg.max(0.0);
-    let mut side = 0i8;
+    // Steps: transfers of support. A step is taken when the other foot carries more than
+    // three quarters of the normal load (weight acceptance); the hysteresis keeps contact
+    // chatter and double support from counting, and samples in flight (< 20 % of m·g on the
+    // ground) keep the current stance. Counting roll crossings instead miscounted Zippy,
+    // whose roll chatters at the hardstop impacts.
+    let mut stance: Option<usize> = None;
     let mut crossings = 0usize;
     for s in win {
-        let x = s.roll_deg - roll_mean;
-        let now = if x > band {
-            1
-        } else if x < -band {
-            -1
-        } else {
-            side
-        };
-        if side != 0 && now != side {
-            crossings += 1;
+        let total = s.normal_force_n[0] + s.normal_force_n[1];
+        if total < 0.2 * m * GRAVITY_MPS2 {
+            continue;
         }
-        side = now;
+        let now = (0..2).find(|&k| s.normal_force_n[k] > STANCE_LOAD_SHARE * total);
+        if let Some(k) = now {
+            if stance.is_some_and(|prev| prev != k) {
+                crossings += 1;
+            }
+            stance = Some(k);
+        }
     }
     r.step_frequency_hz = crossings as f64 / dt;
     r.mechanical_work_j = b.positive_work_j - a.positive_work_j;
@@ -514,13 +522,13 @@ pub fn write_trajectory_csv(samples: &[TrajectorySample], path: &Path) -> Result
     let mut w = std::io::BufWriter::new(file);
     writeln!(
         w,
-        "t_s,x_m,y_m,z_m,roll_deg,pitch_deg,yaw_deg,hip_angle_deg,hip_torque_nm,peak_abs_torque_nm,positive_work_j,feet_in_contact"
+        "t_s,x_m,y_m,z_m,roll_deg,pitch_deg,yaw_deg,hip_angle_deg,hip_torque_nm,peak_abs_torque_nm,positive_work_j,feet_in_contact,left_normal_force_n,right_normal_force_n"
     )
     .map_err(err)?;
     for s in samples {
         writeln!(
             w,
-            "{},{},{},{},{},{},{},{},{},{},{},{}",
+            "{},{},{},{},{},{},{},{},{},{},{},{},{},{}",
             s.t_s,
             s.x_m,
             s.y_m,
@@ -532,7 +540,9 @@ pub fn write_trajectory_csv(samples: &[TrajectorySample], path: &Path) -> Result
             s.hip_torque_nm,
             s.peak_abs_torque_nm,
             s.positive_work_j,
-            s.feet_in_contact
+            s.feet_in_contact,
+            s.normal_force_n[0],
+            s.normal_force_n[1]
         )
         .map_err(err)?;
     }
