@@ -205,6 +205,10 @@ pub struct PowerLawRow {
     /// Seeded case-resampling percentile interval of b (only with `--bootstrap N`).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub b_ci_bootstrap: Option<[f64; 2]>,
+    /// Bias-corrected and accelerated (BCa) bootstrap interval of b from the same
+    /// resamples (only with `--bootstrap N`, and only where BCa is defined).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub b_ci_bootstrap_bca: Option<[f64; 2]>,
 }
 
 /// Table 2 of the paper, for any dataset and fit method.
@@ -267,16 +271,19 @@ pub fn fit_group(
     let fit =
         regression::PowerLawFit::from_log_fit(regression::fit_line(&lx, &ly, method, confidence)?);
     let p_iso = regression::slope_test(&lx, &ly, method, isometric_exponent(x, y))?.p_value;
-    let b_ci_bootstrap = match bootstrap {
+    let (b_ci_bootstrap, b_ci_bootstrap_bca) = match bootstrap {
         Some(cfg) => {
             let cfg = regression::BootstrapConfig {
                 level: confidence,
                 ..cfg
             };
             let boot = regression::bootstrap_line(&lx, &ly, method, cfg)?;
-            Some([boot.b_ci.lower, boot.b_ci.upper])
+            (
+                Some([boot.b_ci.lower, boot.b_ci.upper]),
+                boot.b_bca.map(|c| [c.interval.lower, c.interval.upper]),
+            )
         }
-        None => None,
+        None => (None, None),
     };
     Ok(PowerLawRow {
         class: group,
@@ -294,6 +301,7 @@ pub fn fit_group(
         p_isometry: p_iso,
         confidence,
         b_ci_bootstrap,
+        b_ci_bootstrap_bca,
     })
 }
 

@@ -196,6 +196,13 @@ fn fit_bootstrap_is_seeded_and_deterministic() {
             .expect("bootstrap interval present");
         let (lo, hi) = (ci[0].as_f64().expect("lo"), ci[1].as_f64().expect("hi"));
         assert!(lo < hi, "{f}");
+        let bca = f["b_ci_bootstrap_bca"]
+            .as_array()
+            .expect("BCa interval present");
+        assert!(
+            bca[0].as_f64().expect("lo") < bca[1].as_f64().expect("hi"),
+            "{f}"
+        );
     }
     // Without --bootstrap the key is absent, so the JSON shape of Table 2 is unchanged.
     let plain = common::stdout(&common::survey(&[

@@ -7,8 +7,9 @@ use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use robot_survey::regression::{
     BiasCorrection, BootstrapConfig, CentreKind, Group, Method, RegressionError, back_transform,
-    bootstrap_line, fit_line, fit_power_law, inverse_predict_ols, leave_one_out, log10_checked,
-    ols_diagnostics, predict_ols, predict_power_law, quantile, slope_com, slope_test,
+    bca_interval, bootstrap_line, fit_line, fit_power_law, inverse_predict_ols, jackknife_line,
+    leave_one_out, log10_checked, ols_diagnostics, predict_ols, predict_power_law, quantile,
+    slope_com, slope_test,
 };
 
 #[track_caller]
@@ -350,6 +351,64 @@ fn bootstrap_percentile_ci_agrees_with_analytic_ci_for_large_n() {
         );
         assert!((boot.se_b / fit.se_b - 1.0).abs() < 0.2, "{method:?}");
         assert!(boot.b_ci.contains(fit.b));
+        // For a near-normal, unbiased estimator BCa's corrections are small (|z₀|, |a| ≪ 1)
+        // and its interval lands near the analytic one too.
+        let bca = boot.b_bca.expect("BCa defined");
+        assert!(
+            bca.z0.abs() < 0.2 && bca.acceleration.abs() < 0.05,
+            "{method:?} {bca:?}"
+        );
+        assert!(
+            (bca.interval.lower - fit.b_ci.lower).abs() < 0.2 * width
+                && (bca.interval.upper - fit.b_ci.upper).abs() < 0.2 * width,
+            "{method:?} {bca:?}"
+        );
+        assert!(!bca.extreme_endpoints);
+    }
+}
+
+/// With replicates symmetric about the estimate (z₀ = Φ⁻¹(½) = 0) and antisymmetric
+/// influence values (a = Σl³ = 0), BCa is the plain normal-scale-interpolated percentile
+/// interval, symmetric about the estimate: lower + upper = 2·20.5.
+#[test]
+fn bca_without_bias_or_skew_is_symmetric() {
+    let t: Vec<f64> = (1..=40).map(f64::from).collect();
+    let l = [1.0, -1.0, 2.0, -2.0];
+    let bca = bca_interval(&t, 20.5, &l, 0.95).unwrap();
+    assert_eq!(bca.z0, 0.0);
+    assert_eq!(bca.acceleration, 0.0);
+    close(bca.interval.lower + bca.interval.upper, 41.0, 1e-12);
+    // (R + 1)·0.025 = 1.025: between the 1st and 2nd order statistics.
+    assert!(bca.interval.lower > 1.0 && bca.interval.lower < 2.0);
+    // Every replicate above the estimate: the bias correction is infinite, an error.
+    assert!(bca_interval(&t, 0.5, &l, 0.95).is_err());
+    // All influence values zero: acceleration 0/0, an error.
+    assert!(bca_interval(&t, 20.5, &[0.0; 4], 0.95).is_err());
+}
+
+/// Jackknife by downdating the moments equals refitting each leave-one-out sample.
+#[test]
+fn jackknife_downdate_equals_refits() {
+    let (x, y) = normal_sample(25, 3);
+    for method in [Method::Ols, Method::Sma, Method::Ma] {
+        let (slopes, intercepts) = jackknife_line(&x, &y, method).unwrap();
+        for i in 0..x.len() {
+            let xs: Vec<f64> = x
+                .iter()
+                .enumerate()
+                .filter(|(j, _)| *j != i)
+                .map(|(_, v)| *v)
+                .collect();
+            let ys: Vec<f64> = y
+                .iter()
+                .enumerate()
+                .filter(|(j, _)| *j != i)
+                .map(|(_, v)| *v)
+                .collect();
+            let f = fit_line(&xs, &ys, method, 0.95).unwrap();
+            close(slopes[i], f.b, 1e-12);
+            close(intercepts[i], f.intercept, 1e-12);
+        }
     }
 }
 

@@ -15,6 +15,9 @@
 //! `hatvalues`, `rstandard`, `rstudent`, `cooks.distance`, `predict.lm`, `anova`
 //! and `cor.test`. Printed with `sprintf("%.15g")`.
 //!
+//! The bootstrap section checks BCa intervals and jackknife influence values against the
+//! R `boot` package (1.3-28.1), via `tests/golden/boot.R`.
+//!
 //! Data sets (both public, both text):
 //! - `Animals` (MASS; text copy vincentarelbundock/Rdatasets csv/MASS/Animals.csv
 //!   @cc03c29): brain (g) vs body (kg) of 28 species, the allometry example of
@@ -27,8 +30,9 @@
 //! iterates to 1e-12, so common-slope quantities use smatr's own test tolerance, 1e-5.
 
 use robot_survey::regression::{
-    Group, Method, TestKind, elev_com, elev_test, fit_line, fit_power_law, leave_one_out,
-    ols_diagnostics, predict_ols, slope_com, slope_test,
+    Group, Method, TestKind, bca_interval, elev_com, elev_test, fit_line, fit_power_law,
+    jackknife_influence, jackknife_line, leave_one_out, ols_diagnostics, predict_ols, slope_com,
+    slope_test,
 };
 
 const BODY: [f64; 28] = [
@@ -197,6 +201,76 @@ fn iris_ma_interval_through_the_vertical_matches_line_cis() {
     close(swapped.b_ci.lower, -0.0430083266039083, TIGHT);
     close(swapped.b_ci.upper, 0.192864812839982, TIGHT);
     assert!(!swapped.b_ci_inverted);
+}
+
+// ---------------------------------------------------------- bootstrap (R boot)
+// Expected values from R 4.2.2 with boot 1.3-28.1 (Debian r-base-core): `boot:::bca.ci`
+// with given replicates, estimate and influence values, and `empinf(type = "jack",
+// stype = "i")` for the jackknife influence of the Animals fits.
+
+/// BCa endpoints, bias correction and acceleration against `boot:::bca.ci(NULL, conf,
+/// t0 = 0.3, t = (i/200)^2 + 0.05*sin(i), L = cos(j) + 0.3*sin(2j))`, i = 1..199, j = 1..20.
+#[test]
+fn bca_interval_matches_boot_bca_ci() {
+    let t: Vec<f64> = (1..=199)
+        .map(|i| (f64::from(i) / 200.0).powi(2) + 0.05 * f64::from(i).sin())
+        .collect();
+    let l: Vec<f64> = (1..=20)
+        .map(|j| f64::from(j).cos() + 0.3 * (2.0 * f64::from(j)).sin())
+        .collect();
+    let bca95 = bca_interval(&t, 0.3, &l, 0.95).unwrap();
+    close(bca95.z0, 0.11995018056019, TIGHT);
+    close(bca95.acceleration, 0.00250135684891742, TIGHT);
+    close(bca95.interval.lower, -0.0253472623566444, TIGHT);
+    close(bca95.interval.upper, 0.984252401017934, TIGHT);
+    let bca90 = bca_interval(&t, 0.3, &l, 0.90).unwrap();
+    close(bca90.interval.lower, 0.00236740757289081, TIGHT);
+    close(bca90.interval.upper, 0.946895949976844, TIGHT);
+}
+
+/// Jackknife influence values l_i = (n − 1)(t − t₋ᵢ) of the SMA and MA slopes and of the
+/// OLS intercept on log Animals, and the acceleration Σl³/(6(Σl²)^1.5), against
+/// `empinf(data, statistic, type = "jack", stype = "i")`.
+#[test]
+fn animals_jackknife_influence_matches_boot_empinf() {
+    let (x, y) = animals_log();
+    // (method, slope?, [l_1, l_6, l_26], a)
+    let cases = [
+        (
+            Method::Sma,
+            true,
+            [0.0336283444828711, -0.760523302155861, -1.49833760568467],
+            -0.0635630835425719,
+        ),
+        (
+            Method::Ma,
+            true,
+            [0.115695374624212, -1.28855777080932, -2.08803367131842],
+            -0.0573695104847509,
+        ),
+        (
+            Method::Ols,
+            false,
+            [-0.53695420555145, 0.841585235016732, 1.77238661695218],
+            -0.0294883798986755,
+        ),
+    ];
+    for (method, slope, expected, a) in cases {
+        let full = fit_line(&x, &y, method, 0.95).unwrap();
+        let (slopes, intercepts) = jackknife_line(&x, &y, method).unwrap();
+        let l = if slope {
+            jackknife_influence(&slopes, full.b)
+        } else {
+            jackknife_influence(&intercepts, full.intercept)
+        };
+        for (k, e) in [0, 5, 25].into_iter().zip(expected) {
+            close(l[k], e, TIGHT);
+        }
+        let (s2, s3) = l
+            .iter()
+            .fold((0.0, 0.0), |(s2, s3), v| (s2 + v * v, s3 + v * v * v));
+        close(s3 / (6.0 * s2.powf(1.5)), a, TIGHT);
+    }
 }
 
 #[test]

@@ -50,7 +50,9 @@ pub struct FitArgs {
     /// Write table2.{md,tex,csv,json} and the survey figure (SVG and PNG) into DIR.
     #[arg(long, value_name = "DIR")]
     pub out: Option<PathBuf>,
-    /// Add a seeded case-resampling bootstrap interval of every exponent (N resamples).
+    /// Add seeded case-resampling bootstrap intervals of every exponent (N resamples):
+    /// the percentile interval and the bias-corrected and accelerated (BCa) one, as R's
+    /// boot.ci. BCa needs N well above the sample size; 2000 or more is usual.
     #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(100..=1_000_000))]
     pub bootstrap: Option<u32>,
     /// Seed of the bootstrap (same seed, same intervals).

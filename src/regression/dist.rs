@@ -57,3 +57,17 @@ pub(crate) fn chi2_1_critical(level: f64) -> Result<f64, RegressionError> {
         .inverse_cdf(0.5 + level / 2.0);
     Ok(z * z)
 }
+
+fn standard_normal() -> Result<Normal, RegressionError> {
+    Normal::new(0.0, 1.0).map_err(|_| numerical("normal"))
+}
+
+/// Standard normal quantile Φ⁻¹(p) (±∞ at p = 0, 1).
+pub(crate) fn normal_quantile(p: f64) -> Result<f64, RegressionError> {
+    Ok(standard_normal()?.inverse_cdf(p))
+}
+
+/// Standard normal distribution function Φ(z).
+pub(crate) fn normal_cdf(z: f64) -> Result<f64, RegressionError> {
+    Ok(standard_normal()?.cdf(z))
+}

@@ -25,7 +25,10 @@ mod moments;
 mod power_law;
 mod predict;
 
-pub use bootstrap::{BootstrapConfig, BootstrapResult, bootstrap_line, quantile};
+pub use bootstrap::{
+    BcaInterval, BootstrapConfig, BootstrapResult, bca_interval, bootstrap_line,
+    jackknife_influence, jackknife_line, quantile,
+};
 pub use diagnostics::{LeaveOneOut, OlsDiagnostics, leave_one_out, ols_diagnostics};
 pub use error::RegressionError;
 pub use hypothesis::{

@@ -154,9 +154,13 @@ fn table2_md(t: &Table2) -> String {
         t.fits.first().map(|f| f.confidence * 100.0).unwrap_or(95.0)
     ));
     for f in &t.fits {
+        let bca = f
+            .b_ci_bootstrap_bca
+            .map(|c| format!(", BCa [{:.3}, {:.3}]", c[0], c[1]))
+            .unwrap_or_default();
         let boot = f
             .b_ci_bootstrap
-            .map(|c| format!(" (bootstrap [{:.3}, {:.3}])", c[0], c[1]))
+            .map(|c| format!(" (bootstrap [{:.3}, {:.3}]{bca})", c[0], c[1]))
             .unwrap_or_default();
         out.push_str(&format!(
             "| {} | {} | {} | {:.6} | {:.6} | [{:.3}, {:.3}]{boot} | {:.4} | {} | {:.2e} |\n",
