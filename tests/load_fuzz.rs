@@ -1,6 +1,7 @@
 //! Loading arbitrary bytes never panics: as a record, as a whole upstream table, as a
 //! release table (property tests with proptest).
 
+mod common;
 use proptest::prelude::*;
 use robot_survey::dataset::{
     Vocabulary, record::parse_record, release::parse_table_csv, upstream::import,
@@ -26,21 +27,8 @@ fn tomlish() -> impl Strategy<Value = Vec<u8>> {
     proptest::collection::vec(atoms, 0..12).prop_map(|v| v.concat())
 }
 
-/// Property tests run on a fixed seed so CI is reproducible bit for bit; set
-/// `PROPTEST_RNG_SEED=N` (and `PROPTEST_CASES`) to explore other samples locally.
-/// (A random seed on a fresh CI machine once found the MA cancellation bug (regression_hand.rs) —
-/// worth exploring, not worth a flaky CI.)
-fn reproducible(cases: u32) -> ProptestConfig {
-    let mut config = ProptestConfig::with_cases(cases);
-    if config.rng_seed == proptest::test_runner::RngSeed::Random {
-        config.rng_seed = proptest::test_runner::RngSeed::Fixed(20_261_123);
-    }
-    config.failure_persistence = None;
-    config
-}
-
 proptest! {
-    #![proptest_config(reproducible(400))]
+    #![proptest_config(common::reproducible_proptest(400))]
 
     #[test]
     fn parse_record_never_panics(bytes in tomlish()) {

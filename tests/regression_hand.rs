@@ -2,6 +2,7 @@
 //! regression engine. Every expected number is derived in a comment from the
 //! textbook formula (or is an exact property), never from running this crate.
 
+mod common;
 use proptest::prelude::*;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
@@ -596,21 +597,8 @@ fn ma_slope_of_a_shallow_line_keeps_its_digits() {
     close(xy.b_ci.upper * yx.b_ci.lower, 1.0, 1e-9);
 }
 
-/// Property tests run on a fixed seed so CI is reproducible bit for bit; set
-/// `PROPTEST_RNG_SEED=N` (and `PROPTEST_CASES`) to explore other samples locally.
-/// (A random seed on a fresh CI machine once found the MA cancellation bug (regression_hand.rs) —
-/// worth exploring, not worth a flaky CI.)
-fn reproducible(cases: u32) -> ProptestConfig {
-    let mut config = ProptestConfig::with_cases(cases);
-    if config.rng_seed == proptest::test_runner::RngSeed::Random {
-        config.rng_seed = proptest::test_runner::RngSeed::Fixed(20_261_123);
-    }
-    config.failure_persistence = None;
-    config
-}
-
 proptest! {
-    #![proptest_config(reproducible(200))]
+    #![proptest_config(common::reproducible_proptest(200))]
 
     /// OLS slope from faer's QR solve equals the closed form Sxy/Sxx.
     #[test]

@@ -70,3 +70,17 @@ pub fn dataset_copy() -> tempfile::TempDir {
     copy_tree(&repo().join("dataset"), dir.path());
     dir
 }
+
+/// Property tests run on a fixed seed so CI is reproducible bit for bit; set
+/// `PROPTEST_RNG_SEED=N` (and explore) to draw other samples locally. A random seed on
+/// a fresh CI machine once found the MA cancellation bug (regression_hand.rs,
+/// `ma_slope_of_a_shallow_line_keeps_its_digits`): worth exploring, not worth a flaky CI.
+pub fn reproducible_proptest(cases: u32) -> proptest::test_runner::Config {
+    use proptest::test_runner::{Config, RngSeed};
+    let mut config = Config::with_cases(cases);
+    if config.rng_seed == RngSeed::Random {
+        config.rng_seed = RngSeed::Fixed(20_261_123);
+    }
+    config.failure_persistence = None;
+    config
+}
