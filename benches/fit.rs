@@ -2,6 +2,8 @@
 //!
 //! - `survey_fit_process`: the whole `survey fit` process (start, load the bundled
 //!   dataset, fit 15 power laws, print), as a user runs it. Target < 50 ms.
+//! - `survey_fit_bootstrap_2000_process`: the same with `--bootstrap 2000` (percentile and
+//!   BCa intervals of all 15 exponents).
 //! - `power_law_1m`: one OLS power-law fit (with intervals) over 1,000,000 synthetic robots.
 //! - `table2_1m`: all 15 Table 2 fits over a synthetic 1,000,000-robot survey table.
 //!   Target < 1 s.
@@ -37,19 +39,33 @@ fn synthetic(n: usize) -> (Vec<f64>, Vec<f64>, Vec<f64>, Vec<RobotClass>) {
     (leg, body, mass, class)
 }
 
+/// Runs the real binary (from a directory without `dataset/`, so it uses the bundled
+/// copy) and returns the length of what it printed.
+fn run_survey(exe: &str, args: &[&str]) -> usize {
+    let out = Command::new(exe)
+        .args(args)
+        .current_dir(std::env::temp_dir())
+        .output()
+        .expect("survey runs");
+    assert!(out.status.success());
+    out.stdout.len()
+}
+
 fn bench(c: &mut Criterion) {
     let exe = env!("CARGO_BIN_EXE_survey");
     let mut g = c.benchmark_group("fit");
     g.measurement_time(Duration::from_secs(8));
     g.bench_function("survey_fit_process", |b| {
+        b.iter(|| black_box(run_survey(exe, &["fit", "--format", "json"])))
+    });
+    // The same with 2000 bootstrap resamples of each of the 15 fits (percentile and BCa,
+    // with the jackknife), as `survey fit --bootstrap 2000` is run.
+    g.bench_function("survey_fit_bootstrap_2000_process", |b| {
         b.iter(|| {
-            let out = Command::new(exe)
-                .args(["fit", "--format", "json"])
-                .current_dir(std::env::temp_dir())
-                .output()
-                .expect("survey runs");
-            assert!(out.status.success());
-            black_box(out.stdout.len())
+            black_box(run_survey(
+                exe,
+                &["fit", "--bootstrap", "2000", "--format", "json"],
+            ))
         })
     });
     g.sample_size(10);

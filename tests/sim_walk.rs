@@ -229,3 +229,64 @@ fn mugatu_fixed_material_m_l2_scales_like_froude() {
         "peak torque exponent vs m·L {bt:.3}"
     );
 }
+
+// ------------------------------------------------------------------ known gaps
+// Each states a published fact the model does not yet reproduce; `cargo test -- --ignored`
+// runs them (they fail today, with the measured values in the comment).
+
+/// Zippy's hardware walks at 0.11 m/s (robot dataset) and tops out at 0.25 m/s (Man et al.
+/// 2025); the model walks at 0.042 m/s (Froude v/√(gL) 0.086 vs 0.22 for the hardware).
+#[test]
+#[ignore = "known gap: the Zippy model walks at 0.042 m/s"]
+fn zippy_walks_about_as_fast_as_the_hardware() {
+    let r = walk("zippy", WalkOptions::default());
+    assert_walks_steadily(&r);
+    within_factor("velocity [m/s]", r.velocity_mps, 0.11, 1.5);
+}
+
+/// The paper (Section V) finds ellipsoidal-foot Zippy faster than Mugatu at every scale.
+/// Scaled to the same leg length the model has it slower (Froude 0.086 vs 0.128).
+#[test]
+#[ignore = "known gap: the Zippy model is slower than Mugatu at equal leg length"]
+fn zippy_outpaces_mugatu_at_equal_leg_length() {
+    let at = |name: &str| {
+        walk(
+            name,
+            WalkOptions {
+                leg_length_m: Some(0.15),
+                ..WalkOptions::default()
+            },
+        )
+    };
+    let (z, m) = (at("zippy"), at("mugatu"));
+    assert_walks_steadily(&z);
+    assert_walks_steadily(&m);
+    assert!(
+        z.velocity_mps > m.velocity_mps,
+        "zippy {:.3} m/s vs mugatu {:.3} m/s",
+        z.velocity_mps,
+        m.velocity_mps
+    );
+}
+
+/// The paper's Zippy walks up to L = 1.0 m. With the design's own foot material at every
+/// size the model stops rocking from L = 0.15 m (roll 0.25° p-p) and the scissoring legs
+/// spin it in place (yaw 49° p-p, no progress). For m ∝ L² the fixed modulus is already
+/// the similar one, so the cause is the Hunt–Crossley dissipation d = 30 s/m held fixed
+/// while contact speeds grow ∝ √L: with d scaled as similarity asks (12.2 s/m at 0.15 m),
+/// or with a 10× stiffer foot, it walks at 0.104 m/s. Mugatu walks at every size.
+#[test]
+#[ignore = "known gap: fixed-material Zippy stops rocking at L >= 0.15 m"]
+fn zippy_fixed_material_walks_when_scaled_up() {
+    for l in [0.15, 0.5, 1.0] {
+        let r = walk(
+            "zippy",
+            WalkOptions {
+                leg_length_m: Some(l),
+                contact_scaling: ContactScaling::FixedMaterial,
+                ..WalkOptions::default()
+            },
+        );
+        assert_walks_steadily(&r);
+    }
+}
