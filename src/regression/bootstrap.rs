@@ -123,18 +123,22 @@ pub fn bootstrap_line(
     }
     let lo = (1.0 - config.level) / 2.0;
     let hi = 1.0 - lo;
+    // Percentile and BCa endpoints are both order statistics: sort each set once. Every
+    // replicate is finite (slope_from_moments refused the degenerate resamples).
+    let b_sorted = sorted(&b_samples);
+    let intercept_sorted = sorted(&intercept_samples);
     // BCa needs the jackknife (n ≥ 4 so each leave-one-out sample still has a line).
     let (b_bca, intercept_bca) = match jackknife_line(x, y, method) {
         Ok((jb, ja)) => (
-            bca_interval(
-                &b_samples,
+            bca_of_sorted(
+                &b_sorted,
                 full.b,
                 &jackknife_influence(&jb, full.b),
                 config.level,
             )
             .ok(),
-            bca_interval(
-                &intercept_samples,
+            bca_of_sorted(
+                &intercept_sorted,
                 full.intercept,
                 &jackknife_influence(&ja, full.intercept),
                 config.level,
@@ -150,10 +154,13 @@ pub fn bootstrap_line(
         successful: b_samples.len(),
         b: full.b,
         intercept: full.intercept,
-        b_ci: Interval::new(quantile(&b_samples, lo), quantile(&b_samples, hi)),
+        b_ci: Interval::new(
+            quantile_of_sorted(&b_sorted, lo),
+            quantile_of_sorted(&b_sorted, hi),
+        ),
         intercept_ci: Interval::new(
-            quantile(&intercept_samples, lo),
-            quantile(&intercept_samples, hi),
+            quantile_of_sorted(&intercept_sorted, lo),
+            quantile_of_sorted(&intercept_sorted, hi),
         ),
         b_bca,
         intercept_bca,
@@ -228,18 +235,27 @@ pub fn bca_interval(
     influence: &[f64],
     level: f64,
 ) -> Result<BcaInterval, RegressionError> {
-    dist::check_level(level)?;
-    let mut t: Vec<f64> = replicates
+    let finite: Vec<f64> = replicates
         .iter()
         .copied()
         .filter(|v| v.is_finite())
         .collect();
+    bca_of_sorted(&sorted(&finite), estimate, influence, level)
+}
+
+/// [`bca_interval`] of finite replicates already in ascending order.
+fn bca_of_sorted(
+    t: &[f64],
+    estimate: f64,
+    influence: &[f64],
+    level: f64,
+) -> Result<BcaInterval, RegressionError> {
+    dist::check_level(level)?;
     if t.len() < 2 {
         return Err(RegressionError::InvalidArgument(
             "BCa needs at least 2 finite replicates".into(),
         ));
     }
-    t.sort_by(f64::total_cmp);
     let below = t.iter().filter(|&&v| v < estimate).count();
     let z0 = normal_quantile(below as f64 / t.len() as f64)?;
     if !z0.is_finite() {
@@ -265,7 +281,7 @@ pub fn bca_interval(
     {
         let z = z0 + normal_quantile(alpha)?;
         let adjusted = normal_cdf(z0 + z / (1.0 - acceleration * z))?;
-        let (value, extreme) = normal_interpolated_quantile(&t, adjusted)?;
+        let (value, extreme) = normal_interpolated_quantile(t, adjusted)?;
         *end = value;
         extreme_endpoints |= extreme;
     }
@@ -312,12 +328,22 @@ pub fn quantile(values: &[f64], p: f64) -> f64 {
     if values.is_empty() {
         return f64::NAN;
     }
-    let mut sorted = values.to_vec();
-    sorted.sort_by(f64::total_cmp);
+    quantile_of_sorted(&sorted(values), p)
+}
+
+/// [`quantile`] of a non-empty slice already in ascending order.
+fn quantile_of_sorted(sorted: &[f64], p: f64) -> f64 {
     let h = (sorted.len() - 1) as f64 * p.clamp(0.0, 1.0);
     let lo = h.floor() as usize;
     let hi = (lo + 1).min(sorted.len() - 1);
     sorted[lo] + (h - lo as f64) * (sorted[hi] - sorted[lo])
+}
+
+/// A copy in ascending order (`total_cmp`: NaN last, never a panic).
+fn sorted(values: &[f64]) -> Vec<f64> {
+    let mut v = values.to_vec();
+    v.sort_by(f64::total_cmp);
+    v
 }
 
 fn std_dev(values: &[f64]) -> f64 {

@@ -52,9 +52,7 @@ pub(crate) fn chi2_upper_p(x: f64, df: f64) -> Result<f64, RegressionError> {
 /// `qchisq(level, 1)`, computed as the squared normal quantile because that is
 /// exact and avoids an iterative gamma inversion.
 pub(crate) fn chi2_1_critical(level: f64) -> Result<f64, RegressionError> {
-    let z = Normal::new(0.0, 1.0)
-        .map_err(|_| numerical("normal"))?
-        .inverse_cdf(0.5 + level / 2.0);
+    let z = normal_quantile(0.5 + level / 2.0)?;
     Ok(z * z)
 }
 
