@@ -393,20 +393,9 @@ fn jackknife_downdate_equals_refits() {
     let (x, y) = normal_sample(25, 3);
     for method in [Method::Ols, Method::Sma, Method::Ma] {
         let (slopes, intercepts) = jackknife_line(&x, &y, method).unwrap();
+        let without = |v: &[f64], i: usize| -> Vec<f64> { [&v[..i], &v[i + 1..]].concat() };
         for i in 0..x.len() {
-            let xs: Vec<f64> = x
-                .iter()
-                .enumerate()
-                .filter(|(j, _)| *j != i)
-                .map(|(_, v)| *v)
-                .collect();
-            let ys: Vec<f64> = y
-                .iter()
-                .enumerate()
-                .filter(|(j, _)| *j != i)
-                .map(|(_, v)| *v)
-                .collect();
-            let f = fit_line(&xs, &ys, method, 0.95).unwrap();
+            let f = fit_line(&without(&x, i), &without(&y, i), method, 0.95).unwrap();
             close(slopes[i], f.b, 1e-12);
             close(intercepts[i], f.intercept, 1e-12);
         }

@@ -17,6 +17,18 @@ fn walk(name: &str, opts: WalkOptions) -> WalkReport {
     simulate_walk(&d, &opts).expect("walk runs").report
 }
 
+/// A design scaled to leg length `l` with its own foot material at every size.
+fn walk_fixed_material(name: &str, l: f64) -> WalkReport {
+    walk(
+        name,
+        WalkOptions {
+            leg_length_m: Some(l),
+            contact_scaling: ContactScaling::FixedMaterial,
+            ..WalkOptions::default()
+        },
+    )
+}
+
 /// `value` within a factor `k` of `paper`.
 fn within_factor(what: &str, value: f64, paper: f64, k: f64) {
     assert!(
@@ -201,14 +213,7 @@ fn mugatu_fixed_material_m_l2_scales_like_froude() {
     let runs: Vec<WalkReport> = [0.05, 0.153, 0.5, 1.0]
         .iter()
         .map(|&l| {
-            let r = walk(
-                "mugatu",
-                WalkOptions {
-                    leg_length_m: Some(l),
-                    contact_scaling: ContactScaling::FixedMaterial,
-                    ..WalkOptions::default()
-                },
-            );
+            let r = walk_fixed_material("mugatu", l);
             assert!(r.walks, "L = {l} m does not walk: {r:?}");
             r
         })
@@ -279,14 +284,6 @@ fn zippy_outpaces_mugatu_at_equal_leg_length() {
 #[ignore = "known gap: fixed-material Zippy stops rocking at L >= 0.15 m"]
 fn zippy_fixed_material_walks_when_scaled_up() {
     for l in [0.15, 0.5, 1.0] {
-        let r = walk(
-            "zippy",
-            WalkOptions {
-                leg_length_m: Some(l),
-                contact_scaling: ContactScaling::FixedMaterial,
-                ..WalkOptions::default()
-            },
-        );
-        assert_walks_steadily(&r);
+        assert_walks_steadily(&walk_fixed_material("zippy", l));
     }
 }
