@@ -205,7 +205,7 @@ fn mugatu_velocity_scales_as_sqrt_leg_length() {
 }
 
 /// A real robot's foot material (fixed modulus and damping, m ∝ L²: the sinkage stays the
-/// same fraction of L, only the Hunt–Crossley damping is relatively stronger when small):
+/// same fraction of L, only the Hunt–Crossley damping d·v grows as contact speeds ∝ √L):
 /// Mugatu still walks from L = 0.05 to 1.0 m with v ∝ L^½ (measured 0.512) and the peak hip
 /// torque ∝ m·L (measured exponent 0.965). Bands ± 0.05 / ± 0.1.
 #[test]

@@ -479,8 +479,8 @@ fn analyze(
     // Steps: transfers of support. A step is taken when the other foot carries more than
     // three quarters of the normal load (weight acceptance); the hysteresis keeps contact
     // chatter and double support from counting, and samples in flight (< 20 % of m·g on the
-    // ground) keep the current stance. Counting roll crossings instead miscounted Zippy,
-    // whose roll chatters at the hardstop impacts.
+    // ground) keep the current stance. This is the definition of a step itself; roll-side
+    // crossings (used before) agree on the bundled gaits but are only a proxy for it.
     let mut stance: Option<usize> = None;
     let mut crossings = 0usize;
     for s in win {
