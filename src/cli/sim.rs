@@ -9,6 +9,9 @@ use robot_survey::sim::{self, ContactScaling, Design, MassLaw, WalkOptions};
 
 use super::print;
 
+/// Largest number of sizes in one `sim scale` sweep (each is a full walk).
+const MAX_SWEEP_SIZES: usize = 1000;
+
 #[derive(Args, Debug)]
 pub struct SimArgs {
     #[command(subcommand)]
@@ -23,6 +26,36 @@ pub enum SimCommand {
     /// The scaling study: simulate a design at several leg lengths and fit velocity and
     /// peak hip torque power laws (dynamic similarity predicts v ∝ L^0.5).
     Scale(ScaleArgs),
+    /// Measure the gait of a trajectory recorded elsewhere (Drake through tools/drake/, or
+    /// a measurement exported in the trajectory CSV format) with the same metric code as
+    /// `sim walk`.
+    Analyze(AnalyzeArgs),
+}
+
+#[derive(Args, Debug)]
+#[command(
+    after_help = "Example:\n  survey sim analyze --design mugatu-ref --trajectory tests/golden/drake/walks/mugatu-ref-1.4hz.csv\n\n\
+The design (scaled by --leg-length/--mass-law, drive by --frequency) supplies the size, mass, \
+drive period and walking thresholds; the CSV needs the columns `sim walk --trajectory` writes."
+)]
+pub struct AnalyzeArgs {
+    /// Design the trajectory belongs to: a built-in name or a path to a design TOML.
+    #[arg(long)]
+    pub design: String,
+    /// The trajectory CSV.
+    #[arg(long, value_name = "FILE")]
+    pub trajectory: PathBuf,
+    /// Leg length the design was scaled to [m].
+    #[arg(long, value_name = "M")]
+    pub leg_length: Option<f64>,
+    /// Mass law used when scaling.
+    #[arg(long, value_enum, default_value_t)]
+    pub mass_law: MassLaw,
+    /// Drive frequency of the run [Hz] (default: the design's, scaled).
+    #[arg(long, value_name = "HZ")]
+    pub frequency: Option<f64>,
+    #[arg(long, value_enum, default_value_t)]
+    pub format: SimFormat,
 }
 
 /// What every simulation command needs: the design, how it is scaled, how long it runs.
@@ -114,12 +147,36 @@ pub fn run(a: &SimArgs) -> anyhow::Result<ExitCode> {
     match &a.command {
         SimCommand::Walk(w) => walk(w),
         SimCommand::Scale(s) => scale(s),
+        SimCommand::Analyze(a) => analyze(a),
     }
+}
+
+fn analyze(a: &AnalyzeArgs) -> anyhow::Result<ExitCode> {
+    let design = Design::resolve(&a.design)?;
+    let samples = sim::read_trajectory_csv(&a.trajectory)?;
+    let opts = WalkOptions {
+        leg_length_m: a.leg_length,
+        mass_law: a.mass_law,
+        frequency_hz: a.frequency,
+        ..WalkOptions::default()
+    };
+    let report = sim::report_from_trajectory(&design, &opts, &samples)?;
+    print(&match a.format {
+        SimFormat::Json => report::json(&report)?,
+        SimFormat::Text => report::walk_text(&report),
+    });
+    Ok(ExitCode::SUCCESS)
 }
 
 fn scale(a: &ScaleArgs) -> anyhow::Result<ExitCode> {
     if let Some(bad) = a.leg_lengths.iter().find(|l| !(l.is_finite() && **l > 0.0)) {
         anyhow::bail!("--leg-lengths: {bad} is not a positive length in metres");
+    }
+    if a.leg_lengths.len() > MAX_SWEEP_SIZES {
+        anyhow::bail!(
+            "--leg-lengths: {} sizes given, at most {MAX_SWEEP_SIZES} are accepted in one sweep",
+            a.leg_lengths.len()
+        );
     }
     let design = Design::resolve(&a.run.design)?;
     let base = a.run.options();

@@ -599,6 +599,10 @@ pub fn walk_text(r: &crate::sim::WalkReport) -> String {
         r.duration_s
     );
     match (&r.fall_reason, r.walks) {
+        (Some(reason), _) if reason == "diverged" => out.push_str(&format!(
+            "NUMERICS DIVERGED at {} (not a physical fall: the state blew up; reduce numerics.time_step_s)\n",
+            r.fell_at_s.map(|t| format!("{t:.2} s")).unwrap_or_default()
+        )),
         (Some(reason), _) => out.push_str(&format!(
             "FELL ({reason}) at {}\n",
             r.fell_at_s.map(|t| format!("{t:.2} s")).unwrap_or_default()

@@ -81,6 +81,40 @@ fn bounds(values: impl Iterator<Item = f64>) -> (f64, f64) {
     }
 }
 
+/// Tick positions of a log axis over [lo, hi]: labelled (bold) at 1, 2, 5 × 10^k (with 3
+/// added when the axis spans less than 1.5 decades), light grid lines at the other
+/// integers × 10^k. plotters' own log key points label every integer of the top decade,
+/// which runs the labels together ("0.70.80.91"), and draw a light line per key point,
+/// which packs into a grey band near a decade's end.
+fn log_ticks(lo: f64, hi: f64) -> (Vec<f64>, Vec<f64>) {
+    let (mut bold, mut light) = (Vec::new(), Vec::new());
+    if !(lo > 0.0 && hi > lo && lo.is_finite() && hi.is_finite()) {
+        return (bold, light);
+    }
+    let labelled: &[f64] = if (hi / lo).log10() < 1.5 {
+        &[1.0, 2.0, 3.0, 5.0]
+    } else {
+        &[1.0, 2.0, 5.0]
+    };
+    let (k0, k1) = (lo.log10().floor() as i32, hi.log10().ceil() as i32);
+    for k in k0..=k1 {
+        let decade = 10f64.powi(k);
+        for m in 1..=9 {
+            // Rounded to 12 significant digits so labels print as 0.3, not 0.30000000000000004.
+            let v = (m as f64 * decade * 1e12).round() / 1e12;
+            if v < lo || v > hi {
+                continue;
+            }
+            if labelled.contains(&(m as f64)) {
+                bold.push(v);
+            } else {
+                light.push(v);
+            }
+        }
+    }
+    (bold, light)
+}
+
 fn draw_panel<DB: DrawingBackend>(
     area: &DrawingArea<DB, Shift>,
     panel: &Panel,
@@ -102,7 +136,22 @@ fn draw_panel<DB: DrawingBackend>(
         .margin(12)
         .x_label_area_size(40)
         .y_label_area_size(60)
-        .build_cartesian_2d((xr.0..xr.1).log_scale(), (yr.0..yr.1).log_scale())
+        .build_cartesian_2d(
+            {
+                let (bold, light) = log_ticks(xr.0, xr.1);
+                (xr.0..xr.1)
+                    .log_scale()
+                    .with_key_points(bold)
+                    .with_light_points(light)
+            },
+            {
+                let (bold, light) = log_ticks(yr.0, yr.1);
+                (yr.0..yr.1)
+                    .log_scale()
+                    .with_key_points(bold)
+                    .with_light_points(light)
+            },
+        )
         .map_err(|e| e.to_string())?;
     chart
         .configure_mesh()

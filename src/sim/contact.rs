@@ -30,6 +30,16 @@
 //! the centre velocity scales the force by (1 − d·vₙ₀)₊ and the gradient of vₙ (from the
 //! tangential angular velocity) gives a rolling-resistance moment d·n×(S·(n×ω)).
 //!
+//! Drake's SAP solver models dissipation differently, as a Kelvin–Voigt relaxation time τ_d
+//! (`relaxation_time_s`): the dissipative pressure is −τ_d·g·vₙ(s), with g = E/ρₙ the
+//! pressure field's gradient along the normal, i.e. proportional to the local penetration
+//! *rate* but not to the local pressure. It acts over the whole patch up to its rim (where
+//! Hunt–Crossley's vanishes with p_e), so it damps a foot touching down at once and resists
+//! rolling more for the same bounce damping. Both forms may be set; the total pressure is
+//! clamped at zero point by point over the patch quadrature (a separating rim carries
+//! nothing), as Drake clamps each contact polygon's force. With τ_d = 0 the closed forms
+//! above are used unchanged.
+//!
 //! Friction is Coulomb over the patch, t(s) = −μ·p(s)·v(s)/√(|v(s)|² + v_s²), a smooth
 //! stiction regularisation: below the stiction speed v_s the traction is viscous with
 //! coefficient μp/v_s (micro-slip), above it it saturates at μp. The tangential velocity
@@ -52,6 +62,8 @@ pub struct ContactParams {
     pub friction_mu: f64,
     /// Stiction regularisation speed v_s [m/s].
     pub stiction_speed_mps: f64,
+    /// Kelvin–Voigt relaxation time τ_d [s] (Drake SAP's `relaxation_time`; 0: none).
+    pub relaxation_time_s: f64,
 }
 
 /// Radial Gauss–Legendre nodes/weights on ξ ∈ [0, 1] (3 points).
@@ -136,7 +148,14 @@ pub struct Patch {
     /// of pressure (world x, y) and weights summing to 1.
     pub quad_offsets: [Vector2<f64>; MAX_QUAD],
     pub quad_weights: [f64; MAX_QUAD],
+    /// Area [m²] and elastic pressure [Pa] of each quadrature point (Kelvin–Voigt
+    /// dissipation integrates the local penetration rate over area, clamped point by point).
+    pub quad_area_m2: [f64; MAX_QUAD],
+    pub quad_pressure_pa: [f64; MAX_QUAD],
     pub quad_len: usize,
+    /// Gradient of the pressure field along the ground normal at the deepest point, E/ρₙ
+    /// [Pa/m] (Kelvin–Voigt: dissipative pressure = −τ_d·g·vₙ).
+    pub pressure_gradient_pa_per_m: f64,
     /// True when the section cut clips the patch.
     pub clipped: bool,
 }
@@ -181,7 +200,10 @@ impl Patch {
         inner_radius_m: 0.0,
         quad_offsets: [Vector2::new(0.0, 0.0); MAX_QUAD],
         quad_weights: [0.0; MAX_QUAD],
+        quad_area_m2: [0.0; MAX_QUAD],
+        quad_pressure_pa: [0.0; MAX_QUAD],
         quad_len: 0,
+        pressure_gradient_pa_per_m: 0.0,
         clipped: false,
     };
 }
@@ -278,6 +300,7 @@ pub fn patch_into(
     p.energy_j = 0.0;
     p.inner_radius_m = 0.0;
     p.quad_len = 0;
+    p.pressure_gradient_pa_per_m = modulus_pa / rho;
     p.clipped = clip.is_some();
     // Smallest semi-axis of the patch ellipse = u_max·σ_min(T).
     let sigma_min = {
@@ -304,6 +327,7 @@ pub fn patch_into(
             let mut wsum = 0.0;
             // Stagger rings by half a sector so the 24 points cover the disc evenly.
             let trig = ring_trig();
+            let sector = 2.0 * PI / N_ANGLE as f64 * u_max * u_max * det_t;
             for ((&xi, &wi), ring) in GL_NODES.iter().zip(GL_WEIGHTS.iter()).zip(trig.iter()) {
                 let u = u_max * xi;
                 let pe = (1.0 - (r02 + u * u).sqrt()).max(0.0);
@@ -312,6 +336,8 @@ pub fn patch_into(
                     let k = p.quad_len;
                     p.quad_offsets[k] = t * Vector2::new(u * c, u * s);
                     p.quad_weights[k] = wgt;
+                    p.quad_area_m2[k] = wi * xi * sector;
+                    p.quad_pressure_pa[k] = modulus_pa * pe;
                     wsum += wgt;
                     p.quad_len += 1;
                 }
@@ -365,6 +391,8 @@ pub fn patch_into(
                     }
                     p.quad_offsets[k] = off;
                     p.quad_weights[k] = wgt[l];
+                    p.quad_area_m2[k] = jac[l] * det_t;
+                    p.quad_pressure_pa[k] = modulus_pa * wgt[l] / jac[l].max(1e-300);
                     k += 1;
                 }
             }
@@ -472,6 +500,9 @@ pub fn patch_wrench(
     v_cop: &Vector3<f64>,
     omega: &Vector3<f64>,
 ) -> PatchWrench {
+    if params.relaxation_time_s > 0.0 {
+        return patch_wrench_pointwise(p, params, v_cop, omega);
+    }
     let d = params.dissipation_s_per_m;
     let hc = 1.0 - d * v_cop.z;
     let (fn_total, normal_damping) = if hc > 0.0 {
@@ -506,7 +537,91 @@ pub fn patch_wrench(
     let mut force = Vector3::new(0.0, 0.0, fn_total);
     let mut friction_damping = Matrix3::zeros();
     if fn_total > 0.0 && params.friction_mu > 0.0 {
-        let (f, m_z, k) = patch_friction(p, params, fn_total, v_cop, omega.z);
+        let (f, m_z, k) = patch_friction(
+            p,
+            &p.quad_weights[..p.quad_len],
+            params,
+            fn_total,
+            v_cop,
+            omega.z,
+        );
+        force.x = f.x;
+        force.y = f.y;
+        moment.z += m_z;
+        friction_damping = k;
+    }
+    PatchWrench {
+        force,
+        moment,
+        normal_damping,
+        friction_damping,
+        rolling_damping,
+    }
+}
+
+/// Patch wrench with Kelvin–Voigt (and optionally Hunt–Crossley) dissipation integrated
+/// point by point over the patch quadrature: pᵢ = max(p_e,ᵢ(1 − d·vₙ,ᵢ) − τ_d·g·vₙ,ᵢ, 0),
+/// with vₙ,ᵢ = vₙ(c) + (n×ω)·rᵢ the local normal velocity. Friction is then weighted by the
+/// same point forces, so a point that lifts off carries no friction (as a Drake contact
+/// polygon whose force is clamped to zero).
+fn patch_wrench_pointwise(
+    p: &Patch,
+    params: &ContactParams,
+    v_cop: &Vector3<f64>,
+    omega: &Vector3<f64>,
+) -> PatchWrench {
+    let d = params.dissipation_s_per_m;
+    let kv = params.relaxation_time_s * p.pressure_gradient_pa_per_m;
+    let n = p.quad_len;
+    // Elastic force and centre of pressure are the closed form's; the quadrature's elastic
+    // pressures are rescaled to it so that at rest both paths agree exactly.
+    let quad_elastic: f64 = (0..n)
+        .map(|i| p.quad_pressure_pa[i] * p.quad_area_m2[i])
+        .sum();
+    let scale = if quad_elastic > 0.0 {
+        p.elastic_force_n / quad_elastic
+    } else {
+        0.0
+    };
+    let g = Vector2::new(-omega.y, omega.x);
+    let mut weights = [0.0; MAX_QUAD];
+    let (mut fz, mut mx, mut my) = (0.0, 0.0, 0.0);
+    let mut normal_damping = 0.0;
+    let (mut cxx, mut cxy, mut cyy) = (0.0, 0.0, 0.0);
+    for i in 0..n {
+        let off = p.quad_offsets[i];
+        let area = p.quad_area_m2[i];
+        let pe = p.quad_pressure_pa[i] * scale;
+        let vn = v_cop.z + g.dot(&off);
+        let slope = pe * d + kv;
+        let pi = pe - slope * vn;
+        if pi <= 0.0 {
+            continue;
+        }
+        let f = pi * area;
+        weights[i] = f;
+        fz += f;
+        mx += off.y * f;
+        my -= off.x * f;
+        let c = slope * area;
+        normal_damping += c;
+        cxx += c * off.x * off.x;
+        cxy += c * off.x * off.y;
+        cyy += c * off.y * off.y;
+    }
+    let mut moment = Vector3::new(mx, my, 0.0);
+    let mut force = Vector3::new(0.0, 0.0, fz);
+    let mut rolling_damping = Matrix3::zeros();
+    rolling_damping[(0, 0)] = cyy;
+    rolling_damping[(0, 1)] = -cxy;
+    rolling_damping[(1, 0)] = -cxy;
+    rolling_damping[(1, 1)] = cxx;
+    let mut friction_damping = Matrix3::zeros();
+    if fz > 0.0 && params.friction_mu > 0.0 {
+        for w in weights[..n].iter_mut() {
+            *w /= fz;
+        }
+        let (f, m_z, k) = patch_friction(p, &weights[..n], params, fz, v_cop, omega.z);
         force.x = f.x;
         force.y = f.y;
         moment.z += m_z;
@@ -526,6 +641,7 @@ pub fn patch_wrench(
 /// −∂(F_x, F_y, M_z)/∂(v_x, v_y, ω_z).
 fn patch_friction(
     p: &Patch,
+    quad_weights: &[f64],
     params: &ContactParams,
     fn_total: f64,
     v_cop: &Vector3<f64>,
@@ -553,7 +669,7 @@ fn patch_friction(
         for l in 0..m {
             px[l] = -p.quad_offsets[i + l].y;
             py[l] = p.quad_offsets[i + l].x;
-            cw[l] = mu_f * p.quad_weights[i + l];
+            cw[l] = mu_f * quad_weights[i + l];
         }
         for l in 0..W {
             let vx = vx0 + px[l] * spin;

@@ -16,13 +16,39 @@ use super::model::{FootSection, Hardstop, Leg, Model, State};
 /// Standard gravity [m/s²].
 pub const GRAVITY_MPS2: f64 = 9.81;
 
-/// Built-in designs (bundled so the binary works from any directory).
-pub const BUILTIN_DESIGNS: [(&str, &str); 3] = [
-    ("mugatu", include_str!("../../dataset/walkers/mugatu.toml")),
-    ("zippy", include_str!("../../dataset/walkers/zippy.toml")),
+/// Built-in designs: (name, path in the repository, text). Bundled so the binary works
+/// from any directory. The `-ref` designs are ../shared/research/walker-models.json in this
+/// schema: the models of the Drake cross-check (reports/drake-crosscheck.md).
+pub const BUILTIN_DESIGNS: [(&str, &str, &str); 6] = [
+    (
+        "mugatu",
+        "dataset/walkers/mugatu.toml",
+        include_str!("../../dataset/walkers/mugatu.toml"),
+    ),
+    (
+        "zippy",
+        "dataset/walkers/zippy.toml",
+        include_str!("../../dataset/walkers/zippy.toml"),
+    ),
     (
         "zippy-spherical",
+        "dataset/walkers/zippy-spherical.toml",
         include_str!("../../dataset/walkers/zippy-spherical.toml"),
+    ),
+    (
+        "mugatu-ref",
+        "dataset/walkers/reference/mugatu-ref.toml",
+        include_str!("../../dataset/walkers/reference/mugatu-ref.toml"),
+    ),
+    (
+        "zippy-ref",
+        "dataset/walkers/reference/zippy-ref.toml",
+        include_str!("../../dataset/walkers/reference/zippy-ref.toml"),
+    ),
+    (
+        "zippy-spherical-ref",
+        "dataset/walkers/reference/zippy-spherical-ref.toml",
+        include_str!("../../dataset/walkers/reference/zippy-spherical-ref.toml"),
     ),
 ];
 
@@ -100,9 +126,30 @@ pub struct MassSpec {
 #[serde(deny_unknown_fields)]
 pub struct ContactSpec {
     pub hydroelastic_modulus_pa: f64,
+    /// Hunt–Crossley dissipation d [s/m] (p = p_e·(1 − d·vₙ)); absent: 0.
+    #[serde(default)]
     pub hunt_crossley_dissipation_s_per_m: f64,
     pub friction_mu: f64,
     pub stiction_speed_mps: f64,
+    /// Kelvin–Voigt relaxation time τ_d [s], Drake SAP's dissipation form (dissipative
+    /// pressure −τ_d·(E/ρₙ)·vₙ over the whole patch); absent: 0 (Hunt–Crossley only).
+    #[serde(default)]
+    pub relaxation_time_s: f64,
+}
+
+impl ContactSpec {
+    /// Name of the dissipation form this contact uses (for reports).
+    pub fn dissipation_form(&self) -> &'static str {
+        match (
+            self.relaxation_time_s > 0.0,
+            self.hunt_crossley_dissipation_s_per_m > 0.0,
+        ) {
+            (true, true) => "kelvin-voigt + hunt-crossley",
+            (true, false) => "kelvin-voigt",
+            (false, true) => "hunt-crossley",
+            (false, false) => "none",
+        }
+    }
 }
 
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -222,9 +269,9 @@ impl Design {
         } else {
             key
         };
-        for (n, text) in BUILTIN_DESIGNS {
+        for (n, path, text) in BUILTIN_DESIGNS {
             if n == key {
-                return Design::from_toml_str(text, &format!("dataset/walkers/{n}.toml (bundled)"));
+                return Design::from_toml_str(text, &format!("{path} (bundled)"));
             }
         }
         Err(SimError::UnknownDesign(name.to_string()))
@@ -337,14 +384,20 @@ impl Design {
         check(
             "contact.hydroelastic_modulus_pa",
             c.hydroelastic_modulus_pa,
-            c.hydroelastic_modulus_pa > 0.0,
-            "must be > 0",
+            c.hydroelastic_modulus_pa > 0.0 && c.hydroelastic_modulus_pa <= 1e12,
+            "must be in (0, 1e12] Pa (1e12 is five times steel's Young's modulus)",
         )?;
         check(
             "contact.hunt_crossley_dissipation_s_per_m",
             c.hunt_crossley_dissipation_s_per_m,
             c.hunt_crossley_dissipation_s_per_m >= 0.0,
             "must be ≥ 0",
+        )?;
+        check(
+            "contact.relaxation_time_s",
+            c.relaxation_time_s,
+            c.relaxation_time_s >= 0.0 && c.relaxation_time_s < 1.0,
+            "must be in [0, 1) s",
         )?;
         check(
             "contact.friction_mu",
@@ -535,6 +588,8 @@ impl Design {
             ContactScaling::Similar => {
                 d.contact.hydroelastic_modulus_pa *= mu / (s * s);
                 d.contact.hunt_crossley_dissipation_s_per_m /= time;
+                // A time scale: ∝ the gait's √(L/g) (walker-models.json's rule).
+                d.contact.relaxation_time_s *= time;
             }
             ContactScaling::FixedMaterial => {}
         }
@@ -610,6 +665,7 @@ impl Design {
                 dissipation_s_per_m: self.contact.hunt_crossley_dissipation_s_per_m,
                 friction_mu: self.contact.friction_mu,
                 stiction_speed_mps: self.contact.stiction_speed_mps,
+                relaxation_time_s: self.contact.relaxation_time_s,
             },
             hardstop: self.hardstop.as_ref().map(|h| Hardstop {
                 limit_rad: h.limit_deg.to_radians(),

@@ -6,7 +6,7 @@ use std::path::PathBuf;
 #[derive(Debug, thiserror::Error)]
 pub enum SimError {
     /// A design file could not be read from disk.
-    #[error("cannot read design file {path}: {source}")]
+    #[error("cannot read {path}: {source}")]
     Read {
         path: PathBuf,
         #[source]
@@ -15,6 +15,9 @@ pub enum SimError {
     /// The TOML did not parse or a field has the wrong type / is unknown / is missing.
     #[error("invalid design TOML in {origin}: {message}")]
     Parse { origin: String, message: String },
+    /// A trajectory CSV (from another simulator or a measurement) is malformed.
+    #[error("invalid trajectory {origin}: {message}")]
+    Trajectory { origin: String, message: String },
     /// A field parsed but its value is physically meaningless.
     #[error("invalid value in {origin}: field `{field}` = {value}: {reason}")]
     InvalidValue {
@@ -25,7 +28,7 @@ pub enum SimError {
     },
     /// A design name that is neither built in nor an existing file.
     #[error(
-        "unknown design `{0}`: expected one of mugatu, zippy, zippy-spherical or a path to a .toml file"
+        "unknown design `{0}`: expected one of mugatu, zippy, zippy-spherical, mugatu-ref, zippy-ref, zippy-spherical-ref or a path to a .toml file"
     )]
     UnknownDesign(String),
     /// Bad option passed to a walk (e.g. negative duration).

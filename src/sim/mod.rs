@@ -37,5 +37,6 @@ pub use model::{
 pub use plot::{render_svg, write_plot_svg};
 pub use walk::{
     TrajectorySample, WalkOptions, WalkReport, WalkResult, WalkSetup, hip_frame_attitude,
-    prepare_walk, run_setup, simulate_walk, walks_with_torque_limit, write_trajectory_csv,
+    prepare_walk, read_trajectory_csv, report_from_trajectory, run_setup, simulate_walk,
+    walks_with_torque_limit, write_trajectory_csv,
 };

@@ -13,6 +13,30 @@ use super::model::{Model, Simulator, State, StepInfo};
 /// Share of the normal load a foot must carry to become the stance foot (step counting).
 const STANCE_LOAD_SHARE: f64 = 0.75;
 
+/// Longest walk accepted [s]: an hour of simulated time (the trajectory is kept in memory).
+pub const MAX_DURATION_S: f64 = 3600.0;
+/// Leg lengths a design may be scaled to [m].
+pub const LEG_LENGTH_RANGE_M: (f64, f64) = (1e-3, 100.0);
+/// Largest ω·dt accepted for the stiffest physical oscillation, the foot bouncing on its
+/// contact. The integrator is implicit in the contact stiffness, so larger steps do not
+/// blow up linearly, but the nonlinear contact (force ∝ δ², switching on and off within a
+/// step) does: the bundled designs run at ω·dt = 0.14–0.28, and a 0.5 s step (ω·dt ≈ 70)
+/// diverges.
+pub const MAX_CONTACT_OMEGA_DT: f64 = 1.0;
+
+/// Largest stable time step of a (scaled) design [s]: ω·dt ≤ [`MAX_CONTACT_OMEGA_DT`] for
+/// ω² = k/m, k = dF/dδ of one foot carrying the whole weight upright. For the pressure
+/// field p = E(1 − r) of an ellipsoid (a, b, c) pressed by δ ≪ c along c,
+/// F = π·E·a·b·δ²/c², so k = 2F/δ = 2·√(π·E·a·b·m·g)/c.
+pub fn stable_time_step_s(d: &Design) -> f64 {
+    let [a, b, c] = d.geometry.foot_semi_axes_m;
+    let m = d.mass.total_mass_kg;
+    let e = d.contact.hydroelastic_modulus_pa;
+    let k = 2.0 * (std::f64::consts::PI * e * a * b * m * GRAVITY_MPS2).sqrt() / c;
+    let omega = (k / m).sqrt();
+    MAX_CONTACT_OMEGA_DT / omega
+}
+
 /// Options of a walk (defaults: design's own size, m ∝ L², similar contact, 25 s, no seed).
 #[derive(Clone, Debug, PartialEq)]
 pub struct WalkOptions {
@@ -133,11 +157,25 @@ pub struct WalkSetup {
 
 /// Scales the design, applies the overrides and builds the simulator.
 pub fn prepare_walk(design: &Design, opts: &WalkOptions) -> Result<WalkSetup, SimError> {
-    if !(opts.duration_s > 0.0 && opts.duration_s.is_finite()) {
+    if !(opts.duration_s > 0.0 && opts.duration_s <= MAX_DURATION_S) {
         return Err(SimError::InvalidOption {
             option: "duration_s".into(),
-            reason: format!("must be finite and > 0, got {}", opts.duration_s),
+            reason: format!(
+                "must be in (0, {MAX_DURATION_S}] s (an hour of simulated walking), got {}",
+                opts.duration_s
+            ),
         });
+    }
+    if let Some(l) = opts.leg_length_m {
+        if !(LEG_LENGTH_RANGE_M.0..=LEG_LENGTH_RANGE_M.1).contains(&l) {
+            return Err(SimError::InvalidOption {
+                option: "leg_length_m".into(),
+                reason: format!(
+                    "must be in [{}, {}] m (a 1 mm to 100 m walker), got {l}",
+                    LEG_LENGTH_RANGE_M.0, LEG_LENGTH_RANGE_M.1
+                ),
+            });
+        }
     }
     let d = design.scaled(
         opts.leg_length_m.unwrap_or(design.geometry.leg_length_m),
@@ -167,6 +205,21 @@ pub fn prepare_walk(design: &Design, opts: &WalkOptions) -> Result<WalkSetup, Si
     let state = d.initial_state(&model, opts.seed);
     let effects = d.effects.iter().map(|e| e.build()).collect();
     let dt = d.numerics.time_step_s;
+    let limit = stable_time_step_s(&d);
+    if dt > limit {
+        return Err(SimError::InvalidOption {
+            option: "numerics.time_step_s".into(),
+            reason: format!(
+                "{dt} s (at L = {} m) is beyond the stable limit {limit:.3e} s of the foot contact: \
+                 a foot carrying the weight (E = {} Pa, m = {} kg) vibrates at {:.1} Hz, and the \
+                 step must resolve it (ω·dt ≤ {MAX_CONTACT_OMEGA_DT}); reduce the time step",
+                d.geometry.leg_length_m,
+                d.contact.hydroelastic_modulus_pa,
+                d.mass.total_mass_kg,
+                MAX_CONTACT_OMEGA_DT / limit / std::f64::consts::TAU
+            ),
+        });
+    }
     Ok(WalkSetup {
         simulator: Simulator::new(model, controller, effects, state, dt),
         design: d,
@@ -205,7 +258,8 @@ pub fn run_setup(setup: &mut WalkSetup, opts: &WalkOptions) -> Result<WalkResult
     // About 200 samples per drive cycle resolve the attitude peaks well.
     let record_every = ((1.0 / freq) / (200.0 * dt)).floor().max(1.0) as usize;
     let crit = &d.criteria;
-    let mut samples: Vec<TrajectorySample> = Vec::with_capacity(steps / record_every + 2);
+    let mut samples: Vec<TrajectorySample> =
+        Vec::with_capacity((steps / record_every + 2).min(1 << 16));
     let mut work = 0.0;
     let mut peak = 0.0f64;
     let mut fall: Option<(String, f64)> = None;
@@ -246,7 +300,10 @@ pub fn run_setup(setup: &mut WalkSetup, opts: &WalkOptions) -> Result<WalkResult
         work += (torque * sim.state.hip_rate_rad_s).max(0.0) * dt;
         peak = peak.max(torque.abs());
         if i % record_every == 0 || i == steps {
-            if !sim.state.is_finite() {
+            // A non-finite state, or a speed no walker reaches (100 √(gL): a 0.15 m robot
+            // at 120 m/s), is the integrator blowing up, not the robot falling.
+            let blown_up = sim.state.hip_velocity_mps.norm() > 100.0 * (GRAVITY_MPS2 * l).sqrt();
+            if !sim.state.is_finite() || blown_up {
                 fall = Some(("diverged".into(), sim.time_s));
                 break;
             }
@@ -268,7 +325,12 @@ pub fn run_setup(setup: &mut WalkSetup, opts: &WalkOptions) -> Result<WalkResult
             }
         }
     }
-    let report = analyze(d, sim, opts, &samples, fall);
+    let facts = RunFacts {
+        drive_frequency_hz: freq,
+        torque_limit_nm: sim.controller.torque_limit_nm().unwrap_or(0.0),
+        time_step_s: dt,
+    };
+    let report = analyze(d, &facts, opts, &samples, fall);
     Ok(WalkResult {
         report,
         trajectory: if opts.record_trajectory {
@@ -371,16 +433,157 @@ fn cycle_range(
     (lo, hi)
 }
 
+/// What the metrics need of the run besides its samples.
+struct RunFacts {
+    drive_frequency_hz: f64,
+    torque_limit_nm: f64,
+    time_step_s: f64,
+}
+
+/// Gait metrics of a trajectory recorded elsewhere (another simulator, e.g. Drake through
+/// tools/drake/, or a motion-capture export in the same CSV format), computed by exactly
+/// the code that measures the project's own walks. `design` and `opts` give the scaled
+/// design (size, mass, drive frequency, thresholds); falls are detected on the samples with
+/// the design's criteria, as during a run.
+pub fn report_from_trajectory(
+    design: &Design,
+    opts: &WalkOptions,
+    samples: &[TrajectorySample],
+) -> Result<WalkReport, SimError> {
+    let setup = prepare_walk(design, opts)?;
+    let d = &setup.design;
+    let sim = &setup.simulator;
+    let l = d.geometry.leg_length_m;
+    let crit = &d.criteria;
+    let mut fall = None;
+    for s in samples {
+        let finite = [s.x_m, s.y_m, s.z_m, s.roll_deg, s.pitch_deg, s.yaw_deg]
+            .iter()
+            .all(|x| x.is_finite());
+        let reason = if !finite {
+            Some("diverged")
+        } else if s.z_m < crit.fall_hip_height_over_l * l {
+            Some("hip_low")
+        } else if s.roll_deg.abs() > crit.fall_roll_deg {
+            Some("roll")
+        } else if s.pitch_deg.abs() > crit.fall_pitch_deg {
+            Some("pitch")
+        } else {
+            None
+        };
+        if let Some(r) = reason {
+            fall = Some((r.to_string(), s.t_s));
+            break;
+        }
+    }
+    let mut o = opts.clone();
+    o.duration_s = samples.last().map(|s| s.t_s).unwrap_or(0.0);
+    let facts = RunFacts {
+        drive_frequency_hz: sim.controller.frequency_hz().unwrap_or(1.0),
+        torque_limit_nm: sim.controller.torque_limit_nm().unwrap_or(0.0),
+        time_step_s: sim.dt_s,
+    };
+    let end = fall.as_ref().map_or(samples.len(), |f: &(String, f64)| {
+        samples.partition_point(|s| s.t_s <= f.1)
+    });
+    Ok(analyze(d, &facts, &o, &samples[..end], fall))
+}
+
+/// Reads a trajectory CSV in the format [`write_trajectory_csv`] writes (header names the
+/// columns; extra columns are ignored). Errors name the file, line and column.
+pub fn read_trajectory_csv(path: &Path) -> Result<Vec<TrajectorySample>, SimError> {
+    let text = std::fs::read_to_string(path).map_err(|source| SimError::Read {
+        path: path.to_path_buf(),
+        source,
+    })?;
+    let bad = |line: usize, message: String| SimError::Trajectory {
+        origin: format!("{}, line {line}", path.display()),
+        message,
+    };
+    let mut lines = text.lines().enumerate();
+    let header: Vec<&str> = match lines.next() {
+        Some((_, h)) => h.split(',').map(str::trim).collect(),
+        None => return Err(bad(1, "empty file: expected a header line".into())),
+    };
+    const COLUMNS: [&str; 14] = [
+        "t_s",
+        "x_m",
+        "y_m",
+        "z_m",
+        "roll_deg",
+        "pitch_deg",
+        "yaw_deg",
+        "hip_angle_deg",
+        "hip_torque_nm",
+        "peak_abs_torque_nm",
+        "positive_work_j",
+        "feet_in_contact",
+        "left_normal_force_n",
+        "right_normal_force_n",
+    ];
+    let mut idx = [0usize; 14];
+    for (k, name) in COLUMNS.iter().enumerate() {
+        idx[k] = header
+            .iter()
+            .position(|h| h == name)
+            .ok_or_else(|| bad(1, format!("missing column `{name}`")))?;
+    }
+    let mut out = Vec::new();
+    for (i, line) in lines {
+        if line.trim().is_empty() {
+            continue;
+        }
+        let cells: Vec<&str> = line.split(',').map(str::trim).collect();
+        let mut v = [0.0f64; 14];
+        for (k, name) in COLUMNS.iter().enumerate() {
+            let cell = cells
+                .get(idx[k])
+                .ok_or_else(|| bad(i + 1, format!("column `{name}`: missing cell")))?;
+            v[k] = cell
+                .parse::<f64>()
+                .map_err(|_| bad(i + 1, format!("column `{name}`: `{cell}` is not a number")))?;
+        }
+        if out.last().is_some_and(|p: &TrajectorySample| v[0] <= p.t_s) {
+            return Err(bad(
+                i + 1,
+                format!("column `t_s`: time {} does not increase", v[0]),
+            ));
+        }
+        out.push(TrajectorySample {
+            t_s: v[0],
+            x_m: v[1],
+            y_m: v[2],
+            z_m: v[3],
+            roll_deg: v[4],
+            pitch_deg: v[5],
+            yaw_deg: v[6],
+            hip_angle_deg: v[7],
+            hip_torque_nm: v[8],
+            peak_abs_torque_nm: v[9],
+            positive_work_j: v[10],
+            feet_in_contact: v[11].clamp(0.0, 2.0) as u8,
+            normal_force_n: [v[12], v[13]],
+        });
+    }
+    if out.len() < 3 {
+        return Err(bad(
+            1,
+            format!("{} samples: too few to measure a gait", out.len()),
+        ));
+    }
+    Ok(out)
+}
+
 fn analyze(
     d: &Design,
-    sim: &Simulator,
+    facts: &RunFacts,
     opts: &WalkOptions,
     samples: &[TrajectorySample],
     fall: Option<(String, f64)>,
 ) -> WalkReport {
     let l = d.geometry.leg_length_m;
     let m = d.mass.total_mass_kg;
-    let freq = sim.controller.frequency_hz().unwrap_or(1.0);
+    let freq = facts.drive_frequency_hz;
     let period = 1.0 / freq;
     let t_end = samples.last().map(|s| s.t_s).unwrap_or(0.0);
     let converged_at_s = if fall.is_none() {
@@ -400,9 +603,9 @@ fn analyze(
         mass_law: opts.mass_law,
         contact_scaling: opts.contact_scaling,
         drive_frequency_hz: freq,
-        torque_limit_nm: sim.controller.torque_limit_nm().unwrap_or(0.0),
+        torque_limit_nm: facts.torque_limit_nm,
         duration_s: opts.duration_s,
-        time_step_s: sim.dt_s,
+        time_step_s: facts.time_step_s,
         seed: opts.seed,
         walks: false,
         fall_reason: fall.as_ref().map(|f| f.0.clone()),

@@ -2,7 +2,7 @@
 //! its quirks, every row is accounted for, and the import reproduces frozen release 1.0.0
 //! byte for byte.
 
-mod common;
+use crate::common;
 
 use robot_survey::dataset::upstream::{self, import};
 use robot_survey::dataset::{RobotClass, Value};

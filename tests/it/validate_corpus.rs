@@ -3,7 +3,7 @@
 //! itself (`# expect: SEVERITY RULE FILE FIELD [line=N]`) or in `expect.txt` for cases
 //! that need several records (duplicates, outliers).
 
-mod common;
+use crate::common;
 
 use std::path::PathBuf;
 

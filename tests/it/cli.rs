@@ -1,7 +1,7 @@
 //! The real binary: exit codes (0 ok, 1 problems found, 2 could not run), clear errors
 //! naming what was wrong, nothing written on bad input.
 
-mod common;
+use crate::common;
 
 #[test]
 fn help_explains_every_command_and_exits_0() {

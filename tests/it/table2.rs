@@ -4,7 +4,7 @@
 //! (`../shared/upstream/robot-dataset/fit_summary_powerlaw.txt`, A and b to 6 significant
 //! digits, R² to 4 decimals) and the paper's Table 2 as printed (b to 2, R² to 3 decimals).
 
-mod common;
+use crate::common;
 
 use serde_json::Value;
 

@@ -2,7 +2,7 @@
 //! regression engine. Every expected number is derived in a comment from the
 //! textbook formula (or is an exact property), never from running this crate.
 
-mod common;
+use crate::common;
 use proptest::prelude::*;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;

@@ -1,6 +1,6 @@
 //! The live records: valid, canonical, with an up-to-date data package and intact releases.
 
-mod common;
+use crate::common;
 
 use robot_survey::dataset::{Dataset, DatasetFiles, Severity, canonical, validate::validate};
 

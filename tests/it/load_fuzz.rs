@@ -1,7 +1,7 @@
 //! Loading arbitrary bytes never panics: as a record, as a whole upstream table, as a
 //! release table (property tests with proptest).
 
-mod common;
+use crate::common;
 use proptest::prelude::*;
 use robot_survey::dataset::{
     Vocabulary, record::parse_record, release::parse_table_csv, upstream::import,

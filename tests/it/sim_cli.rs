@@ -1,9 +1,9 @@
 //! `survey sim` through the real binary: JSON keys the issue names, outputs written,
 //! bad input refused with exit 2 and a message naming what was wrong.
 
-mod common;
+use crate::common;
 
-use common::{stderr, stdout, survey};
+use crate::common::{stderr, stdout, survey};
 
 #[test]
 fn walk_json_has_the_documented_keys() {
@@ -75,6 +75,37 @@ fn bad_sim_input_is_exit_2_with_a_clear_message() {
         .replace("total_mass_kg = 0.9", "total_mass_kg = -0.9");
     std::fs::write(&bad, text).expect("write");
     let bad_s = bad.to_str().expect("utf8");
+    // A 0.5 s step (once: ran, and reported `"walks": false` as if the robot fell) and a
+    // modulus of 1e30 Pa (likewise).
+    let mugatu = std::fs::read_to_string(common::repo().join("dataset/walkers/mugatu.toml"))
+        .expect("read mugatu.toml");
+    let step = dir.path().join("step.toml");
+    std::fs::write(
+        &step,
+        mugatu.replace("time_step_s = 0.002", "time_step_s = 0.5"),
+    )
+    .expect("write");
+    let step_s = step.to_str().expect("utf8");
+    let stiff = dir.path().join("stiff.toml");
+    std::fs::write(
+        &stiff,
+        mugatu.replace(
+            "hydroelastic_modulus_pa = 3.0e6",
+            "hydroelastic_modulus_pa = 1e30",
+        ),
+    )
+    .expect("write");
+    let stiff_s = stiff.to_str().expect("utf8");
+    // A trajectory whose second data row (line 3) has a non-number.
+    let traj = dir.path().join("traj.csv");
+    std::fs::write(
+        &traj,
+        "t_s,x_m,y_m,z_m,roll_deg,pitch_deg,yaw_deg,hip_angle_deg,hip_torque_nm,peak_abs_torque_nm,positive_work_j,feet_in_contact,left_normal_force_n,right_normal_force_n\n\
+         0,0,0,0.15,0,0,0,0,0,0,0,2,4,4\n\
+         0.01,0,0,abc,0,0,0,0,0,0,0,2,4,4\n",
+    )
+    .expect("write");
+    let traj_s = traj.to_str().expect("utf8");
     for (args, needle) in [
         (
             vec!["sim", "walk", "--design", "no-such-walker"],
@@ -84,6 +115,26 @@ fn bad_sim_input_is_exit_2_with_a_clear_message() {
         (vec!["sim", "walk", "--duration", "0"], "duration"),
         (vec!["sim", "walk", "--design", bad_s], "total_mass_kg"),
         (vec!["sim", "scale", "--leg-lengths", "0.1,-2"], "-2"),
+        // Once aborted with "memory allocation of 28000000000224 bytes failed" (exit 134).
+        (vec!["sim", "walk", "--duration", "1e9"], "duration"),
+        (vec!["sim", "walk", "--leg-length", "1e4"], "leg_length"),
+        (vec!["sim", "walk", "--frequency", "nan"], "frequency"),
+        (vec!["sim", "walk", "--design", step_s], "stable limit"),
+        (
+            vec!["sim", "walk", "--design", stiff_s],
+            "hydroelastic_modulus_pa",
+        ),
+        (
+            vec![
+                "sim",
+                "analyze",
+                "--design",
+                "mugatu",
+                "--trajectory",
+                traj_s,
+            ],
+            "line 3",
+        ),
     ] {
         let o = survey(&args);
         assert_eq!(o.status.code(), Some(2), "{args:?}: {}", stderr(&o));

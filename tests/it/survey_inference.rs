@@ -8,9 +8,9 @@
 //! - "paper:" values are quoted from the paper (seed text, Sec. VI and conclusion);
 //! - "hand:" values are arithmetic done in the comment.
 
-mod common;
+use crate::common;
 
-use common::{stderr, stdout, survey};
+use crate::common::{stderr, stdout, survey};
 use serde_json::Value;
 
 fn json(args: &[&str]) -> Value {

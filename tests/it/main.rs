@@ -1,0 +1,17 @@
+//! One integration-test crate: each module was once its own test binary; linking the
+//! crate and its dependencies once instead of fourteen times is most of a fresh `cargo test`.
+
+mod cli;
+mod common;
+mod live_dataset;
+mod load_fuzz;
+mod regression_hand;
+mod regression_smatr;
+mod sim_cli;
+mod sim_physics;
+mod sim_scaling;
+mod sim_walk;
+mod survey_inference;
+mod table2;
+mod upstream_import;
+mod validate_corpus;
