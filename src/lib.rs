@@ -5,9 +5,11 @@
 //! - [`regression`]: log–log power laws (OLS, MA, SMA), intervals, tests, diagnostics.
 //! - [`survey`]: the paper's analyses over a dataset (Table 2, predictions).
 //! - [`sim`]: 3D quasi-passive walker simulation; [`scaling`]: the scaling study over it.
+//! - [`crosscheck`]: the simulator against Drake on identical models (goldens from tools/drake/).
 //! - [`predict`], [`inference`], [`laws`]: designer predictions, hypothesis tests, Table 1.
 //! - [`report`]: output formats (md, tex, csv, json) and figures.
 
+pub mod crosscheck;
 pub mod dataset;
 pub mod inference;
 pub mod laws;

@@ -30,6 +30,33 @@ pub enum SimCommand {
     /// a measurement exported in the trajectory CSV format) with the same metric code as
     /// `sim walk`.
     Analyze(AnalyzeArgs),
+    /// The Drake cross-check: run every elementary case of the goldens' cases.toml in this
+    /// engine and compare with Drake's and the analytic values; compare every Drake walk
+    /// golden with this engine's walk of the same design (both measured by this code).
+    Crosscheck(CrosscheckArgs),
+}
+
+#[derive(Args, Debug)]
+#[command(
+    after_help = "Example:\n  survey sim crosscheck --golden tests/golden/drake --format md\n\n\
+The goldens are made by tools/drake/harness.py (Drake, Python); this command needs neither."
+)]
+pub struct CrosscheckArgs {
+    /// Folder with cases.toml, elementary.json and walks/ (from tools/drake/).
+    #[arg(long, value_name = "DIR", default_value = "tests/golden/drake")]
+    pub golden: PathBuf,
+    /// Repository root the case and walk design paths are relative to.
+    #[arg(long, value_name = "DIR", default_value = ".")]
+    pub root: PathBuf,
+    /// md (tables for reports/drake-crosscheck.md) or json.
+    #[arg(long, value_enum, default_value_t = CrosscheckFormat::Md)]
+    pub format: CrosscheckFormat,
+}
+
+#[derive(ValueEnum, Debug, Clone, Copy, PartialEq, Eq)]
+pub enum CrosscheckFormat {
+    Md,
+    Json,
 }
 
 #[derive(Args, Debug)]
@@ -148,7 +175,22 @@ pub fn run(a: &SimArgs) -> anyhow::Result<ExitCode> {
         SimCommand::Walk(w) => walk(w),
         SimCommand::Scale(s) => scale(s),
         SimCommand::Analyze(a) => analyze(a),
+        SimCommand::Crosscheck(c) => crosscheck(c),
     }
+}
+
+fn crosscheck(a: &CrosscheckArgs) -> anyhow::Result<ExitCode> {
+    let bar = indicatif::ProgressBar::new_spinner();
+    let result = robot_survey::crosscheck::run(&a.root, &a.golden, &|what| {
+        bar.set_message(format!("running {what}"));
+        bar.tick();
+    })?;
+    bar.finish_and_clear();
+    print(&match a.format {
+        CrosscheckFormat::Json => report::json(&result)?,
+        CrosscheckFormat::Md => report::crosscheck_md(&result),
+    });
+    Ok(ExitCode::SUCCESS)
 }
 
 fn analyze(a: &AnalyzeArgs) -> anyhow::Result<ExitCode> {

@@ -2,6 +2,9 @@
 //! LaTeX (booktabs), CSV or JSON; figures live in [`plot`].
 
 pub mod plot;
+mod crosscheck;
+
+pub use crosscheck::crosscheck_md;
 
 use serde::Serialize;
 

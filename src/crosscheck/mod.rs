@@ -1,0 +1,698 @@
+//! Cross-check of the walker simulator against Drake on identical models.
+//!
+//! The Drake side is a Python harness (`tools/drake/`) that reads the same design TOMLs and
+//! the same case definitions (`tests/golden/drake/cases.toml`) and writes goldens
+//! (`tests/golden/drake/elementary.json`, `walks/*.csv`, `walks/*.json`). This module is
+//! the project side: it runs each elementary case in the project's engine and measures it
+//! exactly as the harness does (the same windows, fits and crossings), and it re-analyses
+//! Drake's walk trajectories with the project's own gait metrics
+//! ([`crate::sim::report_from_trajectory`]) so both engines' walks are measured by one code.
+//! The Rust build never needs Python or Drake.
+
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+
+use nalgebra::{UnitQuaternion, Vector3};
+use serde::{Deserialize, Serialize};
+
+use crate::sim::{
+    Controller, Design, GRAVITY_MPS2, SimError, Simulator, State, WalkOptions, WalkReport,
+    hip_frame_attitude, read_trajectory_csv, report_from_trajectory, simulate_walk,
+};
+
+/// Errors of the cross-check (reading goldens, running cases).
+#[derive(Debug, thiserror::Error)]
+pub enum CrosscheckError {
+    #[error("cannot read {path}: {message}")]
+    Read { path: PathBuf, message: String },
+    #[error("{path}: {message}")]
+    Invalid { path: PathBuf, message: String },
+    #[error(transparent)]
+    Sim(#[from] SimError),
+}
+
+fn read(path: &Path) -> Result<String, CrosscheckError> {
+    std::fs::read_to_string(path).map_err(|e| CrosscheckError::Read {
+        path: path.to_path_buf(),
+        message: e.to_string(),
+    })
+}
+
+/// Initial condition of a case (cases.toml `initial`).
+#[derive(Clone, Debug, Deserialize, Serialize)]
+pub struct CaseInitial {
+    #[serde(default)]
+    pub roll_deg: f64,
+    #[serde(default)]
+    pub pitch_deg: f64,
+    #[serde(default)]
+    pub yaw_deg: f64,
+    /// Left-leg angular velocity in the left-leg frame [rad/s].
+    #[serde(default)]
+    pub angular_velocity_rad_s: [f64; 3],
+    /// Hip-point velocity, world [m/s].
+    #[serde(default)]
+    pub linear_velocity_mps: [f64; 3],
+    /// "design", "touch" or "static" (see cases.toml).
+    #[serde(default = "default_placement")]
+    pub placement: String,
+}
+
+fn default_placement() -> String {
+    "design".into()
+}
+
+/// One elementary case of cases.toml.
+#[derive(Clone, Debug, Deserialize, Serialize)]
+pub struct Case {
+    pub design: String,
+    #[serde(default)]
+    pub overrides: toml::Table,
+    #[serde(default = "default_drive")]
+    pub drive: String,
+    #[serde(default = "default_true")]
+    pub ground_contact: bool,
+    #[serde(default = "default_gravity")]
+    pub gravity_mps2: f64,
+    pub duration_s: f64,
+    pub initial: CaseInitial,
+    #[serde(default)]
+    pub measure: Vec<String>,
+    #[serde(default)]
+    pub method: String,
+}
+
+fn default_drive() -> String {
+    "design".into()
+}
+fn default_true() -> bool {
+    true
+}
+fn default_gravity() -> f64 {
+    GRAVITY_MPS2
+}
+
+#[derive(Deserialize)]
+struct CasesFile {
+    cases: BTreeMap<String, Case>,
+}
+
+/// Reads cases.toml.
+pub fn load_cases(path: &Path) -> Result<BTreeMap<String, Case>, CrosscheckError> {
+    let text = read(path)?;
+    let f: CasesFile = toml::from_str(&text).map_err(|e| CrosscheckError::Invalid {
+        path: path.to_path_buf(),
+        message: e.to_string(),
+    })?;
+    Ok(f.cases)
+}
+
+/// Applies dotted-key overrides ("a.b" = v sets [a] b = v) to a design TOML table.
+fn apply_overrides(design: &mut toml::Table, overrides: &toml::Table) {
+    for (key, value) in overrides {
+        let parts: Vec<&str> = key.split('.').collect();
+        let mut node = &mut *design;
+        for p in &parts[..parts.len() - 1] {
+            let entry = node
+                .entry(p.to_string())
+                .or_insert_with(|| toml::Value::Table(toml::Table::new()));
+            if !entry.is_table() {
+                *entry = toml::Value::Table(toml::Table::new());
+            }
+            node = match entry {
+                toml::Value::Table(t) => t,
+                _ => unreachable!("just made a table"),
+            };
+        }
+        node.insert(parts[parts.len() - 1].to_string(), value.clone());
+    }
+}
+
+/// The design of a case with its overrides applied (paths relative to `root`).
+pub fn case_design(root: &Path, case: &Case) -> Result<Design, CrosscheckError> {
+    let path = root.join(&case.design);
+    let text = read(&path)?;
+    let mut table: toml::Table = toml::from_str(&text).map_err(|e| CrosscheckError::Invalid {
+        path: path.clone(),
+        message: e.to_string(),
+    })?;
+    apply_overrides(&mut table, &case.overrides);
+    let text = toml::to_string(&table).map_err(|e| CrosscheckError::Invalid {
+        path: path.clone(),
+        message: e.to_string(),
+    })?;
+    Ok(Design::from_toml_str(
+        &text,
+        &format!("{} (with the case's overrides)", path.display()),
+    )?)
+}
+
+/// Depth at which one upright ellipsoid foot carries `load_n` under p = E(1 − r):
+/// (π/3)·E·a·b·(1 − r₀)²(1 + 2r₀) with r₀ = 1 − δ/c (bisection, as the harness).
+fn solve_sinkage(e: f64, semi: [f64; 3], load_n: f64) -> f64 {
+    let force = |d: f64| {
+        let r0 = (1.0 - d / semi[2]).max(0.0);
+        std::f64::consts::FRAC_PI_3 * e * semi[0] * semi[1] * (1.0 - r0).powi(2) * (1.0 + 2.0 * r0)
+    };
+    let (mut lo, mut hi) = (0.0, semi[2]);
+    for _ in 0..200 {
+        let mid = 0.5 * (lo + hi);
+        if force(mid) < load_n {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    0.5 * (lo + hi)
+}
+
+/// Every step of a case: what the measurements need.
+#[derive(Default)]
+struct Trace {
+    t: Vec<f64>,
+    hip: Vec<Vector3<f64>>,
+    roll_deg: Vec<f64>,
+    pitch_deg: Vec<f64>,
+    hip_angle_rad: Vec<f64>,
+    omega_left_w: Vec<Vector3<f64>>,
+    com: Vec<Vector3<f64>>,
+    vcom: Vec<Vector3<f64>>,
+    normal_n: Vec<[f64; 2]>,
+    feet: Vec<u8>,
+    torque_nm: Vec<f64>,
+}
+
+fn record(tr: &mut Trace, sim: &Simulator, normal: [f64; 2], feet: u8, torque: f64) {
+    let s = &sim.state;
+    let model = &sim.model;
+    let kin = model.kinematics(s);
+    let (roll, pitch, _) = hip_frame_attitude(model, s);
+    let m = model.total_mass_kg();
+    let mut com = Vector3::zeros();
+    let mut vcom = Vector3::zeros();
+    for k in 0..2 {
+        let mk = model.legs[k].mass_kg;
+        let r = kin.com_offset_w[k];
+        com += (s.hip_position_m + r) * mk;
+        vcom += (s.hip_velocity_mps + kin.omega_w[k].cross(&r)) * mk;
+    }
+    tr.t.push(sim.time_s);
+    tr.hip.push(s.hip_position_m);
+    tr.roll_deg.push(roll.to_degrees());
+    tr.pitch_deg.push(pitch.to_degrees());
+    tr.hip_angle_rad.push(s.hip_angle_rad);
+    tr.omega_left_w.push(kin.omega_w[0]);
+    tr.com.push(com / m);
+    tr.vcom.push(vcom / m);
+    tr.normal_n.push(normal);
+    tr.feet.push(feet);
+    tr.torque_nm.push(torque);
+}
+
+/// Runs a case in the project's engine and records every step.
+fn run_trace(design: &Design, case: &Case) -> Result<(Trace, Design), CrosscheckError> {
+    let mut d = design.clone();
+    let controller = match case.drive.as_str() {
+        "design" => d.controller(),
+        "hold" => {
+            match &mut d.control {
+                crate::sim::design::ControlSpec::ServoSine { amplitude_deg, .. } => {
+                    *amplitude_deg = 0.0
+                }
+                _ => {
+                    return Err(CrosscheckError::Invalid {
+                        path: PathBuf::from(&case.design),
+                        message: "drive = \"hold\" needs a servo_sine design".into(),
+                    });
+                }
+            }
+            d.controller()
+        }
+        "passive" => Controller::Passive,
+        other => {
+            return Err(CrosscheckError::Invalid {
+                path: PathBuf::from(&case.design),
+                message: format!("unknown drive `{other}` (design, hold or passive)"),
+            });
+        }
+    };
+    let mut model = d.model();
+    model.ground_contact = case.ground_contact;
+    let slope = d.ground.slope_deg.to_radians();
+    model.gravity_mps2 = Vector3::new(slope.sin(), 0.0, -slope.cos()) * case.gravity_mps2;
+    let init = &case.initial;
+    let orientation = UnitQuaternion::from_euler_angles(
+        init.roll_deg.to_radians(),
+        init.pitch_deg.to_radians(),
+        init.yaw_deg.to_radians(),
+    );
+    let r = *orientation.to_rotation_matrix().matrix();
+    let nf = r.transpose() * Vector3::z();
+    let mut hip_z = f64::NEG_INFINITY;
+    for leg in &model.legs {
+        let a = leg.foot_semi_axes_m;
+        let support =
+            (a.x * a.x * nf.x * nf.x + a.y * a.y * nf.y * nf.y + a.z * a.z * nf.z * nf.z).sqrt();
+        hip_z = hip_z.max(support - (r * leg.foot_center_m).z);
+    }
+    let e = model.contact.modulus_pa;
+    match init.placement.as_str() {
+        "design" => {
+            hip_z -= (model.total_mass_kg() * GRAVITY_MPS2 / (std::f64::consts::PI * e)).sqrt()
+        }
+        "static" => {
+            let semi = model.legs[0].foot_semi_axes_m;
+            let load = model.total_mass_kg() * model.gravity_mps2.z.abs() / 2.0;
+            hip_z -= solve_sinkage(e, [semi.x, semi.y, semi.z], load);
+        }
+        "touch" => {}
+        other => {
+            return Err(CrosscheckError::Invalid {
+                path: PathBuf::from(&case.design),
+                message: format!("unknown placement `{other}` (design, touch or static)"),
+            });
+        }
+    }
+    let v = init.linear_velocity_mps;
+    let w = init.angular_velocity_rad_s;
+    let state = State {
+        hip_position_m: Vector3::new(0.0, 0.0, hip_z),
+        orientation,
+        hip_angle_rad: 0.0,
+        hip_velocity_mps: Vector3::new(v[0], v[1], v[2]),
+        angular_velocity_rad_s: Vector3::new(w[0], w[1], w[2]),
+        hip_rate_rad_s: 0.0,
+    };
+    let effects = d.effects.iter().map(|e| e.build()).collect();
+    let dt = d.numerics.time_step_s;
+    let mut sim = Simulator::new(model, controller, effects, state, dt);
+    let mut tr = Trace::default();
+    record(&mut tr, &sim, [0.0, 0.0], 0, 0.0);
+    let n = (case.duration_s / dt).round() as usize;
+    for _ in 0..n {
+        let info = sim.step();
+        if !sim.state.is_finite() {
+            return Err(SimError::Diverged { time_s: sim.time_s }.into());
+        }
+        record(
+            &mut tr,
+            &sim,
+            info.normal_force_n,
+            info.feet_in_contact,
+            info.actuator_torque_nm,
+        );
+    }
+    Ok((tr, d))
+}
+
+fn zero_crossings(t: &[f64], y: &[f64]) -> Vec<f64> {
+    let mut out = Vec::new();
+    for i in 1..y.len() {
+        if (y[i - 1] > 0.0) != (y[i] > 0.0) && y[i - 1] != y[i] {
+            out.push(t[i - 1] + (t[i] - t[i - 1]) * (0.0 - y[i - 1]) / (y[i] - y[i - 1]));
+        }
+    }
+    out
+}
+
+/// Local maxima > 0, refined by a parabola through the 3 samples around each.
+fn positive_peaks(t: &[f64], y: &[f64]) -> Vec<(f64, f64)> {
+    let mut pk = Vec::new();
+    for i in 1..y.len().saturating_sub(1) {
+        if y[i] > 0.0 && y[i] >= y[i - 1] && y[i] > y[i + 1] {
+            let (a, b, c) = (y[i - 1], y[i], y[i + 1]);
+            let den = a - 2.0 * b + c;
+            let off = if den != 0.0 { 0.5 * (a - c) / den } else { 0.0 };
+            pk.push((t[i] + off * (t[i + 1] - t[i]), b - 0.25 * (a - c) * off));
+        }
+    }
+    pk
+}
+
+/// Least-squares slope of y on t.
+fn line_slope(t: &[f64], y: &[f64]) -> Option<f64> {
+    let n = t.len() as f64;
+    if t.len() < 2 {
+        return None;
+    }
+    let (mt, my) = (t.iter().sum::<f64>() / n, y.iter().sum::<f64>() / n);
+    let sxy: f64 = t.iter().zip(y).map(|(a, b)| (a - mt) * (b - my)).sum();
+    let sxx: f64 = t.iter().map(|a| (a - mt) * (a - mt)).sum();
+    (sxx > 0.0).then(|| sxy / sxx)
+}
+
+fn first_below(t: &[f64], y: &[f64], level: f64) -> Option<f64> {
+    for i in 1..y.len() {
+        if (y[i] <= level && level < y[i - 1]) || (y[i] <= level && i == 1 && y[0] <= level) {
+            if y[i - 1] == y[i] {
+                return Some(t[i]);
+            }
+            return Some(t[i - 1] + (t[i] - t[i - 1]) * (y[i - 1] - level) / (y[i - 1] - y[i]));
+        }
+    }
+    None
+}
+
+fn interp_at(t: &[f64], y: &[f64], tq: f64) -> f64 {
+    let i = t.partition_point(|&x| x < tq);
+    if i == 0 {
+        return y[0];
+    }
+    if i >= t.len() {
+        return y[y.len() - 1];
+    }
+    let f = (tq - t[i - 1]) / (t[i] - t[i - 1]);
+    y[i - 1] + f * (y[i] - y[i - 1])
+}
+
+/// Least squares of x on (1, t, t²/2): the acceleration.
+fn quadratic_acceleration(t: &[f64], x: &[f64]) -> Option<f64> {
+    let n = t.len();
+    if n < 3 {
+        return None;
+    }
+    let mut a = nalgebra::DMatrix::<f64>::zeros(n, 3);
+    for (i, &ti) in t.iter().enumerate() {
+        a[(i, 0)] = 1.0;
+        a[(i, 1)] = ti;
+        a[(i, 2)] = 0.5 * ti * ti;
+    }
+    let b = nalgebra::DVector::from_column_slice(x);
+    a.svd(true, true).solve(&b, 1e-14).ok().map(|s| s[2])
+}
+
+/// Amplitude, phase lag and offset of q ≈ a·sin(wt) + b·cos(wt) + c.
+fn fit_sine(t: &[f64], q: &[f64], w: f64) -> Option<(f64, f64, f64)> {
+    let n = t.len();
+    let mut a = nalgebra::DMatrix::<f64>::zeros(n, 3);
+    for (i, &ti) in t.iter().enumerate() {
+        a[(i, 0)] = (w * ti).sin();
+        a[(i, 1)] = (w * ti).cos();
+        a[(i, 2)] = 1.0;
+    }
+    let b = nalgebra::DVector::from_column_slice(q);
+    let s = a.svd(true, true).solve(&b, 1e-14).ok()?;
+    Some(((s[0] * s[0] + s[1] * s[1]).sqrt(), -s[1].atan2(s[0]), s[2]))
+}
+
+fn window(t: &[f64], lo: f64, hi: f64) -> std::ops::Range<usize> {
+    let i0 = t.partition_point(|&x| x < lo - 1e-12);
+    let i1 = t.partition_point(|&x| x <= hi + 1e-12);
+    i0..i1
+}
+
+/// Measured quantities of one case (the names of cases.toml `measure`, plus a few extra
+/// diagnostics); `None` where a quantity is undefined (e.g. never stopped).
+pub type Measured = BTreeMap<String, Option<f64>>;
+
+/// Runs a case in the project's engine and measures it as the Drake harness does.
+pub fn run_case(root: &Path, name: &str, case: &Case) -> Result<Measured, CrosscheckError> {
+    let design = case_design(root, case)?;
+    let (tr, d) = run_trace(&design, case)?;
+    let t = &tr.t;
+    let mut m = Measured::new();
+    let mut put = |k: &str, v: Option<f64>| {
+        m.insert(k.to_string(), v);
+    };
+    let unknown = || CrosscheckError::Invalid {
+        path: PathBuf::from("cases.toml"),
+        message: format!("case `{name}`: no measurement defined for it in the project"),
+    };
+    if name.starts_with("sinkage") {
+        let w = window(t, t[t.len() - 1] - 0.2, f64::INFINITY);
+        let n = w.len() as f64;
+        let z0 = tr.hip[0].z;
+        let z_end = tr.hip[w.clone()].iter().map(|p| p.z).sum::<f64>() / n;
+        put("sinkage_m", Some(z0 - z_end));
+        put(
+            "left_normal_force_n",
+            Some(tr.normal_n[w.clone()].iter().map(|f| f[0]).sum::<f64>() / n),
+        );
+        put(
+            "right_normal_force_n",
+            Some(tr.normal_n[w.clone()].iter().map(|f| f[1]).sum::<f64>() / n),
+        );
+        put(
+            "feet_in_contact",
+            Some((tr.feet[w].iter().map(|&f| f as f64).sum::<f64>() / n).round()),
+        );
+    } else if name == "free_rocking" {
+        let zc = zero_crossings(t, &tr.roll_deg);
+        let mut pk = vec![(0.0, tr.roll_deg[0])];
+        pk.extend(positive_peaks(t, &tr.roll_deg));
+        let period = if zc.len() >= 9 {
+            Some((0..7).map(|k| zc[k + 2] - zc[k]).sum::<f64>() / 7.0)
+        } else if zc.len() >= 3 {
+            Some((0..zc.len() - 2).map(|k| zc[k + 2] - zc[k]).sum::<f64>() / (zc.len() - 2) as f64)
+        } else {
+            None
+        };
+        put("roll_period_s", period);
+        put(
+            "roll_decay_ratio_per_cycle",
+            (pk.len() >= 5).then(|| (pk[4].1 / pk[0].1).powf(0.25)),
+        );
+        put(
+            "both_feet_in_contact_fraction",
+            Some(tr.feet[1..].iter().filter(|&&f| f == 2).count() as f64 / (t.len() - 1) as f64),
+        );
+    } else if name == "rolling_incline" {
+        let x: Vec<f64> = tr.com.iter().map(|c| c.x).collect();
+        for (key, lo, hi) in [
+            ("com_acceleration_mps2", 0.05, 1.0),
+            ("com_acceleration_early_mps2", 0.05, 0.25),
+        ] {
+            let w = window(t, lo, hi);
+            put(key, quadratic_acceleration(&t[w.clone()], &x[w]));
+        }
+        let r = d.geometry.foot_semi_axes_m[2];
+        let last = t.len() - 1;
+        put("com_velocity_at_end_mps", Some(tr.vcom[last].x));
+        put(
+            "slip_velocity_at_end_mps",
+            Some(tr.vcom[last].x - tr.omega_left_w[last].y * r),
+        );
+    } else if name == "spin_down" {
+        let wz: Vec<f64> = tr.omega_left_w.iter().map(|w| w.z).collect();
+        let w0 = case.initial.angular_velocity_rad_s[2];
+        let (ts, ys): (Vec<f64>, Vec<f64>) = t
+            .iter()
+            .zip(&wz)
+            .filter(|&(&ti, &y)| ti > 0.0 && y >= 0.1 * w0 && y <= 0.9 * w0)
+            .map(|(&a, &b)| (a, b))
+            .unzip();
+        put("yaw_deceleration_rad_s2", line_slope(&ts, &ys).map(|s| -s));
+        put("stop_time_s", first_below(t, &wz, 0.01 * w0));
+        put("yaw_rate_at_end_rad_s", Some(wz[wz.len() - 1]));
+    } else if name == "slide" {
+        let v: Vec<f64> = tr.vcom.iter().map(|c| c.x).collect();
+        let x: Vec<f64> = tr.com.iter().map(|c| c.x).collect();
+        let v0 = case.initial.linear_velocity_mps[0];
+        let (ts, ys): (Vec<f64>, Vec<f64>) = t
+            .iter()
+            .zip(&v)
+            .filter(|&(&ti, &y)| ti > 0.0 && y >= 0.1 * v0 && y <= 0.9 * v0)
+            .map(|(&a, &b)| (a, b))
+            .unzip();
+        put("deceleration_mps2", line_slope(&ts, &ys).map(|s| -s));
+        let stop = first_below(t, &v, 0.01 * v0);
+        put("stop_time_s", stop);
+        put(
+            "stopping_distance_m",
+            stop.map(|ts| interp_at(t, &x, ts) - x[0]),
+        );
+        put("velocity_at_end_mps", Some(v[v.len() - 1]));
+    } else if name == "creep" {
+        let x: Vec<f64> = tr.com.iter().map(|c| c.x).collect();
+        put(
+            "creep_speed_mps",
+            Some((interp_at(t, &x, 1.0) - interp_at(t, &x, 0.5)) / 0.5),
+        );
+        put("creep_speed_at_end_mps", Some(tr.vcom[tr.vcom.len() - 1].x));
+        put("displacement_m", Some(x[x.len() - 1] - x[0]));
+    } else if name == "servo_in_air" {
+        let (amp_rad, freq) = match d.control {
+            crate::sim::design::ControlSpec::ServoSine {
+                amplitude_deg,
+                frequency_hz,
+                ..
+            } => (amplitude_deg.to_radians(), frequency_hz),
+            _ => return Err(unknown()),
+        };
+        let w = window(t, 2.0, 3.0);
+        let fit = fit_sine(
+            &t[w.clone()],
+            &tr.hip_angle_rad[w.clone()],
+            std::f64::consts::TAU * freq,
+        );
+        put("amplitude_deg", fit.map(|f| f.0.to_degrees()));
+        put("amplitude_ratio", fit.map(|f| f.0 / amp_rad));
+        put("phase_lag_deg", fit.map(|f| f.1.to_degrees()));
+        put(
+            "peak_abs_torque_nm_last_second",
+            Some(tr.torque_nm[w].iter().fold(0.0, |a: f64, b| a.max(b.abs()))),
+        );
+    } else {
+        return Err(unknown());
+    }
+    let _ = &tr.pitch_deg;
+    Ok(m)
+}
+
+/// A walk compared in both engines: the same design TOML and options.
+#[derive(Clone, Debug, Serialize)]
+pub struct WalkComparison {
+    /// Golden file stem (tests/golden/drake/walks/STEM.csv).
+    pub name: String,
+    pub design: String,
+    pub leg_length_m: f64,
+    pub drive_frequency_hz: f64,
+    /// The project's walk.
+    pub project: WalkReport,
+    /// Drake's trajectory measured by the project's gait metrics.
+    pub drake: WalkReport,
+}
+
+/// How a Drake walk golden was made (walks/STEM.json, written by the harness).
+#[derive(Clone, Debug, Deserialize)]
+pub struct WalkGoldenMeta {
+    pub design: String,
+    #[serde(default)]
+    pub leg_length_m: Option<f64>,
+    #[serde(default)]
+    pub frequency_hz: Option<f64>,
+    #[serde(default)]
+    pub duration_s: Option<f64>,
+}
+
+/// Runs the project's walk for a Drake walk golden (STEM.json + STEM.csv) and measures
+/// both with the project's metrics.
+pub fn compare_walk(root: &Path, json_path: &Path) -> Result<WalkComparison, CrosscheckError> {
+    let text = read(json_path)?;
+    let meta: WalkGoldenMeta =
+        serde_json::from_str(&text).map_err(|e| CrosscheckError::Invalid {
+            path: json_path.to_path_buf(),
+            message: e.to_string(),
+        })?;
+    let design_path = root.join(&meta.design);
+    let design = if design_path.exists() {
+        Design::from_file(&design_path)?
+    } else {
+        Design::resolve(&meta.design)?
+    };
+    let opts = WalkOptions {
+        leg_length_m: meta.leg_length_m,
+        frequency_hz: meta.frequency_hz,
+        duration_s: meta.duration_s.unwrap_or(25.0),
+        record_trajectory: false,
+        ..WalkOptions::default()
+    };
+    let project = simulate_walk(&design, &opts)?.report;
+    let csv = json_path.with_extension("csv");
+    let samples = read_trajectory_csv(&csv)?;
+    let drake = report_from_trajectory(&design, &opts, &samples)?;
+    Ok(WalkComparison {
+        name: json_path
+            .file_stem()
+            .map(|s| s.to_string_lossy().into_owned())
+            .unwrap_or_default(),
+        design: meta.design,
+        leg_length_m: project.leg_length_m,
+        drive_frequency_hz: project.drive_frequency_hz,
+        project,
+        drake,
+    })
+}
+
+/// One measured quantity of an elementary case in both engines and, where one exists,
+/// its analytic value.
+#[derive(Clone, Debug, Serialize)]
+pub struct QuantityRow {
+    pub case: String,
+    pub quantity: String,
+    pub project: Option<f64>,
+    pub drake: Option<f64>,
+    pub analytic: Option<f64>,
+}
+
+impl QuantityRow {
+    /// (project − Drake)/|Drake|.
+    pub fn relative_difference(&self) -> Option<f64> {
+        match (self.project, self.drake) {
+            (Some(p), Some(d)) if d != 0.0 => Some((p - d) / d.abs()),
+            _ => None,
+        }
+    }
+}
+
+/// The whole cross-check: every elementary case and every walk golden.
+#[derive(Clone, Debug, Serialize)]
+pub struct Crosscheck {
+    pub drake_version: Option<String>,
+    pub elementary: Vec<QuantityRow>,
+    pub walks: Vec<WalkComparison>,
+}
+
+fn number(v: Option<&serde_json::Value>) -> Option<f64> {
+    v.and_then(serde_json::Value::as_f64)
+}
+
+/// Runs the project's side of every case in `golden/cases.toml` and every walk in
+/// `golden/walks/*.json`, beside Drake's and the analytic values from
+/// `golden/elementary.json`. `root` is the repository (design paths are relative to it).
+pub fn run(
+    root: &Path,
+    golden: &Path,
+    progress: &dyn Fn(&str),
+) -> Result<Crosscheck, CrosscheckError> {
+    let cases = load_cases(&golden.join("cases.toml"))?;
+    let elementary_path = golden.join("elementary.json");
+    let drake: serde_json::Value = if elementary_path.exists() {
+        serde_json::from_str(&read(&elementary_path)?).map_err(|e| CrosscheckError::Invalid {
+            path: elementary_path.clone(),
+            message: e.to_string(),
+        })?
+    } else {
+        serde_json::Value::Null
+    };
+    let mut rows = Vec::new();
+    for (name, case) in &cases {
+        progress(name);
+        let ours = run_case(root, name, case)?;
+        let theirs = &drake["cases"][name.as_str()];
+        for (q, v) in &ours {
+            rows.push(QuantityRow {
+                case: name.clone(),
+                quantity: q.clone(),
+                project: *v,
+                drake: number(theirs["measured"].get(q)),
+                analytic: number(theirs["analytic"].get(q)),
+            });
+        }
+    }
+    let mut walks = Vec::new();
+    let dir = golden.join("walks");
+    if dir.is_dir() {
+        let mut files: Vec<PathBuf> = std::fs::read_dir(&dir)
+            .map_err(|e| CrosscheckError::Read {
+                path: dir.clone(),
+                message: e.to_string(),
+            })?
+            .filter_map(Result::ok)
+            .map(|e| e.path())
+            .filter(|p| {
+                p.extension().is_some_and(|e| e == "json") && p.with_extension("csv").exists()
+            })
+            .collect();
+        files.sort();
+        for f in files {
+            progress(&f.display().to_string());
+            walks.push(compare_walk(root, &f)?);
+        }
+    }
+    Ok(Crosscheck {
+        drake_version: drake["drake_version"].as_str().map(str::to_string),
+        elementary: rows,
+        walks,
+    })
+}

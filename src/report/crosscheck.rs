@@ -1,0 +1,63 @@
+//! The Drake cross-check as Markdown (reports/drake-crosscheck.md's tables).
+
+use crate::crosscheck::Crosscheck;
+
+fn cell(v: Option<f64>) -> String {
+    match v {
+        Some(x) if x.is_finite() => super::sig(x),
+        _ => "—".into(),
+    }
+}
+
+fn pct(v: Option<f64>) -> String {
+    match v {
+        Some(x) if x.is_finite() => format!("{:+.1} %", 100.0 * x),
+        _ => "—".into(),
+    }
+}
+
+/// Elementary cases (project, Drake, analytic, difference) and walks (both engines
+/// measured by the project's gait metrics).
+pub fn crosscheck_md(c: &Crosscheck) -> String {
+    let mut out = String::new();
+    out.push_str(&format!(
+        "Drake {}; project: this build. Walks: both trajectories measured by the project's gait metrics.\n\n",
+        c.drake_version.as_deref().unwrap_or("(no goldens found)")
+    ));
+    out.push_str("| case | quantity | project | Drake | analytic | project − Drake |\n|---|---|---|---|---|---|\n");
+    for r in &c.elementary {
+        out.push_str(&format!(
+            "| {} | {} | {} | {} | {} | {} |\n",
+            r.case,
+            r.quantity,
+            cell(r.project),
+            cell(r.drake),
+            cell(r.analytic),
+            pct(r.relative_difference())
+        ));
+    }
+    out.push_str("\n| walk | engine | walks | v [m/s] | step f [Hz] | roll p-p [°] | pitch p-p [°] | yaw p-p [°] |\n|---|---|---|---|---|---|---|---|\n");
+    for w in &c.walks {
+        for (engine, r) in [("project", &w.project), ("Drake", &w.drake)] {
+            out.push_str(&format!(
+                "| {} | {} | {} | {} | {} | {} ± {} | {} ± {} | {} ± {} |\n",
+                w.name,
+                engine,
+                match (&r.fall_reason, r.walks) {
+                    (Some(f), _) => format!("fell ({f})"),
+                    (None, true) => "yes".into(),
+                    (None, false) => "no".into(),
+                },
+                cell(Some(r.velocity_mps)),
+                cell(Some(r.step_frequency_hz)),
+                cell(Some(r.roll_pp_deg)),
+                cell(Some(r.roll_pp_deg_sd)),
+                cell(Some(r.pitch_pp_deg)),
+                cell(Some(r.pitch_pp_deg_sd)),
+                cell(Some(r.yaw_pp_deg)),
+                cell(Some(r.yaw_pp_deg_sd)),
+            ));
+        }
+    }
+    out
+}
