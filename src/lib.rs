@@ -7,10 +7,12 @@
 //! - [`sim`]: 3D quasi-passive walker simulation; [`scaling`]: the scaling study over it.
 //! - [`crosscheck`]: the simulator against Drake on identical models (goldens from tools/drake/).
 //! - [`predict`], [`inference`], [`laws`]: designer predictions, hypothesis tests, Table 1.
+//! - [`diff`]: the live records against a frozen release, for a pull request's reviewer.
 //! - [`report`]: output formats (md, tex, csv, json) and figures.
 
 pub mod crosscheck;
 pub mod dataset;
+pub mod diff;
 pub mod inference;
 pub mod laws;
 pub mod predict;

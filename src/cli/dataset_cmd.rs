@@ -25,6 +25,11 @@ pub struct ValidateArgs {
     /// {file, robot, field, severity, rule, message}.
     #[arg(long, value_enum, default_value_t)]
     pub format: TextOrJson,
+    /// With --release: also check the release's rows against the record rules and its
+    /// fits for outliers (lists the known problems the release was frozen with);
+    /// without it, --release checks the release's integrity only.
+    #[arg(long, requires = "release")]
+    pub rows: bool,
 }
 
 #[derive(Args, Debug)]
@@ -119,15 +124,42 @@ fn dataset_dir(ds: &Dataset) -> anyhow::Result<PathBuf> {
 pub fn validate(a: &ValidateArgs) -> anyhow::Result<ExitCode> {
     let ds = load(&a.data)?;
     let mut rep = dataset::validate::validate(&ds);
+    let mut checked = None;
     if let Some(v) = &a.data.release {
-        // With --release, only that release's integrity is in question.
-        ds.table(Some(v))?;
+        // With --release, that release's integrity is in question, and with --rows its rows.
+        let table = ds.table(Some(v))?;
         rep.problems.retain(|p| {
             p.rule == dataset::Rule::ReleaseIntegrity && p.file.contains(&format!("releases/{v}/"))
         });
+        if a.rows {
+            rep.problems
+                .extend(dataset::validate::validate_release_rows(&ds, v)?);
+        }
+        rep.dataset = ds.files.display(&format!("releases/{v}"));
+        rep.version = v.clone();
+        rep.records = table.rows.len();
+        checked = Some(if a.rows {
+            format!(
+                "checked release {v}: integrity (sha256 against the manifest) and its {} rows against the record rules",
+                table.rows.len()
+            )
+        } else {
+            format!(
+                "checked release {v}: integrity only (sha256 against the manifest); add --rows to check its rows against the record rules"
+            )
+        });
     }
     match a.format {
-        TextOrJson::Text => print(&report::validation_text(&rep)),
+        TextOrJson::Text => {
+            let mut text = report::validation_text(&rep);
+            match checked {
+                Some(c) => text.push_str(&format!("{c}\n")),
+                None => text.push_str(&dataset::validate::coverage_text(
+                    &dataset::validate::coverage(&ds),
+                )),
+            }
+            print(&text)
+        }
         TextOrJson::Json => print(&report::json(&rep.problems)?),
     }
     Ok(if rep.errors() > 0 {

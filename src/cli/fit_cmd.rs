@@ -47,7 +47,8 @@ pub struct FitArgs {
     /// Confidence level of the intervals.
     #[arg(long, default_value_t = 0.95, value_parser = parse_confidence)]
     pub confidence: f64,
-    /// Write table2.{md,tex,csv,json} and the survey figure (SVG and PNG) into DIR.
+    /// Write table2.{md,tex,csv,json}, the survey figure (SVG and PNG) and the interactive
+    /// page survey.html (self-contained, hover for each robot's values) into DIR.
     #[arg(long, value_name = "DIR")]
     pub out: Option<PathBuf>,
     /// Add seeded case-resampling bootstrap intervals of every exponent (N resamples):
@@ -120,6 +121,10 @@ pub fn fit(a: &FitArgs) -> anyhow::Result<ExitCode> {
             report::plot::draw_panels(&path, &panels, (1400, 620))?;
             written.push(path);
         }
+        let path = dir.join("survey.html");
+        let page = report::html::survey_html(&report::html::survey_figure(&table, &t2));
+        robot_survey::dataset::canonical::write_atomic(&path, page.as_bytes())?;
+        written.push(path);
         eprintln!(
             "wrote {}",
             written

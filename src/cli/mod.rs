@@ -2,6 +2,7 @@
 //! found (validation errors, a check that failed), 2 could not run (bad input, I/O).
 
 mod dataset_cmd;
+mod diff_cmd;
 mod fit_cmd;
 mod sim;
 
@@ -49,6 +50,8 @@ pub enum Command {
     Validate(dataset_cmd::ValidateArgs),
     /// Fit the survey's power laws per class (the paper's Table 2).
     Fit(fit_cmd::FitArgs),
+    /// Compare the live records with a frozen release: records, validation, Table 2.
+    Diff(diff_cmd::DiffArgs),
     /// Predict mass and body length for a target leg length (or leg length for a mass budget).
     Predict(fit_cmd::PredictArgs),
     /// Hypothesis tests on the power laws (slope value, common slope, elevation).
@@ -85,6 +88,7 @@ fn run(cli: Cli) -> anyhow::Result<ExitCode> {
     match cli.command {
         Command::Validate(a) => dataset_cmd::validate(&a),
         Command::Fit(a) => fit_cmd::fit(&a),
+        Command::Diff(a) => diff_cmd::diff(&a),
         Command::Predict(a) => fit_cmd::predict(&a),
         Command::Test(a) => fit_cmd::test(&a),
         Command::Laws(a) => fit_cmd::laws(&a),

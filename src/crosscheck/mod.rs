@@ -494,12 +494,40 @@ pub fn run_case(root: &Path, name: &str, case: &Case) -> Result<Measured, Crossc
             .filter(|&(&ti, &y)| ti > 0.0 && y >= 0.1 * v0 && y <= 0.9 * v0)
             .map(|(&a, &b)| (a, b))
             .unzip();
-        put("deceleration_mps2", line_slope(&ts, &ys).map(|s| -s));
         let stop = first_below(t, &v, 0.01 * v0);
+        let distance = stop.map(|ts| interp_at(t, &x, ts) - x[0]);
         put("stop_time_s", stop);
+        put("stopping_distance_m", distance);
+        put("deceleration_mps2", stop.map(|ts| v0 / ts));
         put(
-            "stopping_distance_m",
-            stop.map(|ts| interp_at(t, &x, ts) - x[0]),
+            "deceleration_from_distance_mps2",
+            distance.map(|d| v0 * v0 / (2.0 * d)),
+        );
+        put(
+            "deceleration_linefit_mps2",
+            line_slope(&ts, &ys).map(|s| -s),
+        );
+        let z0 = tr.hip[0].z;
+        put(
+            "max_hop_height_m",
+            Some(
+                tr.hip
+                    .iter()
+                    .map(|p| p.z - z0)
+                    .fold(f64::NEG_INFINITY, f64::max),
+            ),
+        );
+        put(
+            "airborne_fraction_while_sliding",
+            stop.map(|ts| {
+                let k = t[1..].iter().filter(|&&ti| ti < ts).count();
+                let air = t[1..]
+                    .iter()
+                    .zip(&tr.feet[1..])
+                    .filter(|&(&ti, &f)| ti < ts && f == 0)
+                    .count();
+                air as f64 / k.max(1) as f64
+            }),
         );
         put("velocity_at_end_mps", Some(v[v.len() - 1]));
     } else if name == "creep" {
@@ -553,16 +581,33 @@ pub struct WalkComparison {
     pub drake: WalkReport,
 }
 
-/// How a Drake walk golden was made (walks/STEM.json, written by the harness).
+/// The options a Drake walk golden was run with (walks/STEM.json `options`).
 #[derive(Clone, Debug, Deserialize)]
-pub struct WalkGoldenMeta {
-    pub design: String,
+pub struct WalkGoldenOptions {
     #[serde(default)]
     pub leg_length_m: Option<f64>,
+    #[serde(default)]
+    pub mass_law: Option<String>,
     #[serde(default)]
     pub frequency_hz: Option<f64>,
     #[serde(default)]
     pub duration_s: Option<f64>,
+    /// Relaxation time and time step multiplied by these (sensitivity variants).
+    #[serde(default = "one")]
+    pub relaxation_scale: f64,
+    #[serde(default = "one")]
+    pub time_step_scale: f64,
+}
+
+fn one() -> f64 {
+    1.0
+}
+
+/// How a Drake walk golden was made (walks/STEM.json, written by the harness).
+#[derive(Clone, Debug, Deserialize)]
+pub struct WalkGoldenMeta {
+    pub design_file: String,
+    pub options: WalkGoldenOptions,
 }
 
 /// Runs the project's walk for a Drake walk golden (STEM.json + STEM.csv) and measures
@@ -574,16 +619,30 @@ pub fn compare_walk(root: &Path, json_path: &Path) -> Result<WalkComparison, Cro
             path: json_path.to_path_buf(),
             message: e.to_string(),
         })?;
-    let design_path = root.join(&meta.design);
-    let design = if design_path.exists() {
+    let design_path = root.join(&meta.design_file);
+    let mut design = if design_path.exists() {
         Design::from_file(&design_path)?
     } else {
-        Design::resolve(&meta.design)?
+        Design::resolve(&meta.design_file)?
+    };
+    let o = &meta.options;
+    design.contact.relaxation_time_s *= o.relaxation_scale;
+    design.numerics.time_step_s *= o.time_step_scale;
+    let mass_law = match o.mass_law.as_deref() {
+        None | Some("l2") => crate::sim::MassLaw::L2,
+        Some("l3") => crate::sim::MassLaw::L3,
+        Some(other) => {
+            return Err(CrosscheckError::Invalid {
+                path: json_path.to_path_buf(),
+                message: format!("options.mass_law `{other}` (l2 or l3)"),
+            });
+        }
     };
     let opts = WalkOptions {
-        leg_length_m: meta.leg_length_m,
-        frequency_hz: meta.frequency_hz,
-        duration_s: meta.duration_s.unwrap_or(25.0),
+        leg_length_m: o.leg_length_m,
+        mass_law,
+        frequency_hz: o.frequency_hz,
+        duration_s: o.duration_s.unwrap_or(25.0),
         record_trajectory: false,
         ..WalkOptions::default()
     };
@@ -596,7 +655,7 @@ pub fn compare_walk(root: &Path, json_path: &Path) -> Result<WalkComparison, Cro
             .file_stem()
             .map(|s| s.to_string_lossy().into_owned())
             .unwrap_or_default(),
-        design: meta.design,
+        design: meta.design_file,
         leg_length_m: project.leg_length_m,
         drive_frequency_hz: project.drive_frequency_hz,
         project,

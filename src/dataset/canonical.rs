@@ -27,9 +27,8 @@ pub fn float(x: f64) -> String {
     }
 }
 
-fn datum(d: &Datum, ty: Option<FieldType>) -> String {
-    let mut parts = Vec::new();
-    match &d.value {
+fn value_parts(value: &Value, ty: Option<FieldType>, parts: &mut Vec<String>) {
+    match value {
         Value::Number(x) => parts.push(format!("value = {}", float(*x))),
         Value::Integer(i) if ty == Some(FieldType::Number) => {
             parts.push(format!("value = {}", float(*i as f64)))
@@ -46,7 +45,10 @@ fn datum(d: &Datum, ty: Option<FieldType>) -> String {
             }
         }
     }
-    match d.sources.as_slice() {
+}
+
+fn source_part(sources: &[String], parts: &mut Vec<String>) {
+    match sources {
         [] => {}
         [one] => parts.push(format!("source = {}", quote(one))),
         many => parts.push(format!(
@@ -54,8 +56,41 @@ fn datum(d: &Datum, ty: Option<FieldType>) -> String {
             many.iter().map(|s| quote(s)).collect::<Vec<_>>().join(", ")
         )),
     }
+}
+
+/// A value as an inline table, keys in this order: value (or min, max), source, at,
+/// derived, derivation, note, history.
+fn datum(d: &Datum, ty: Option<FieldType>) -> String {
+    let mut parts = Vec::new();
+    value_parts(&d.value, ty, &mut parts);
+    source_part(&d.sources, &mut parts);
+    if let Some(a) = &d.at {
+        parts.push(format!("at = {}", quote(a)));
+    }
+    if d.derived {
+        parts.push("derived = true".into());
+    }
+    if let Some(x) = &d.derivation {
+        parts.push(format!("derivation = {}", quote(x)));
+    }
     if let Some(n) = &d.note {
         parts.push(format!("note = {}", quote(n)));
+    }
+    if !d.history.is_empty() {
+        let entries: Vec<String> = d
+            .history
+            .iter()
+            .map(|h| {
+                let mut p = Vec::new();
+                value_parts(&h.value, ty, &mut p);
+                source_part(&h.sources, &mut p);
+                if let Some(n) = &h.note {
+                    p.push(format!("note = {}", quote(n)));
+                }
+                format!("{{ {} }}", p.join(", "))
+            })
+            .collect();
+        parts.push(format!("history = [{}]", entries.join(", ")));
     }
     format!("{{ {} }}", parts.join(", "))
 }

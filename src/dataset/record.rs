@@ -80,16 +80,28 @@ pub enum SourceKind {
     Web,
     Lab,
     Dataset,
+    /// A robot description file (URDF, MJCF, CAD) published by the maker or the lab.
+    Model,
+    /// A restatement of a primary source (news, encyclopedia, distributor, review).
+    Secondary,
 }
 
 impl SourceKind {
-    pub const ALL: [SourceKind; 5] = [
+    pub const ALL: [SourceKind; 7] = [
         SourceKind::Paper,
         SourceKind::Datasheet,
         SourceKind::Web,
         SourceKind::Lab,
         SourceKind::Dataset,
+        SourceKind::Model,
+        SourceKind::Secondary,
     ];
+    /// Whether a source of this kind is where a value was first published (the maker's
+    /// datasheet or page, the robot's paper, the lab, its description files), as opposed
+    /// to a table that transcribes it (`dataset`) or a restatement (`secondary`).
+    pub fn is_primary(self) -> bool {
+        !matches!(self, SourceKind::Dataset | SourceKind::Secondary)
+    }
     pub fn as_str(self) -> &'static str {
         match self {
             SourceKind::Paper => "paper",
@@ -97,6 +109,8 @@ impl SourceKind {
             SourceKind::Web => "web",
             SourceKind::Lab => "lab",
             SourceKind::Dataset => "dataset",
+            SourceKind::Model => "model",
+            SourceKind::Secondary => "secondary",
         }
     }
     pub fn parse(s: &str) -> Option<Self> {
@@ -143,12 +157,50 @@ impl Value {
 }
 
 /// A value with its provenance.
-#[derive(Debug, Clone, PartialEq, Serialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Default)]
 pub struct Datum {
     pub value: Value,
     /// Keys of the record's sources that support this value.
     pub sources: Vec<String>,
+    /// Where in the source the value is stated: page, table, section (`at = "Table I"`).
+    pub at: Option<String>,
+    /// The value is not stated directly but derived from what the source states
+    /// (e.g. hip height = thigh + shank + foot height); `derivation` says how.
+    pub derived: bool,
+    pub derivation: Option<String>,
     pub note: Option<String>,
+    /// Earlier values this one replaced (e.g. the survey's value before a primary source
+    /// corrected it), oldest first: kept so that no transcribed value silently disappears.
+    pub history: Vec<Earlier>,
+}
+
+/// A value a record used to give, with where it came from.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Earlier {
+    pub value: Value,
+    pub sources: Vec<String>,
+    pub note: Option<String>,
+}
+
+impl Default for Value {
+    fn default() -> Self {
+        Value::Range {
+            min: None,
+            max: None,
+        }
+    }
+}
+
+impl Datum {
+    /// A value with sources and nothing else.
+    pub fn new(value: Value, sources: Vec<String>, note: Option<String>) -> Self {
+        Datum {
+            value,
+            sources,
+            note,
+            ..Datum::default()
+        }
+    }
 }
 
 /// A parsed robot record.
@@ -477,36 +529,99 @@ fn parse_values(
             continue;
         };
         for k in t.keys() {
-            if !["value", "min", "max", "source", "note"].contains(&k.as_str()) {
+            if !VALUE_KEYS.contains(&k.as_str()) {
                 problems.push(mk(
                     Rule::UnknownField,
-                    format!("unknown key `{k}` in `{name}` (value, min, max, source, note)"),
+                    format!("unknown key `{k}` in `{name}` ({})", VALUE_KEYS.join(", ")),
                 ));
             }
         }
-        let sources = match t.get("source") {
-            None => Vec::new(),
-            Some(toml::Value::String(s)) => vec![s.clone()],
-            Some(toml::Value::Array(a)) if a.iter().all(|v| v.is_str()) => a
-                .iter()
-                .filter_map(|v| v.as_str().map(str::to_string))
-                .collect(),
-            Some(_) => {
+        let sources = source_keys(t.get("source"), &mut |m| problems.push(mk(Rule::Type, m)));
+        let note = t.get("note").and_then(|v| v.as_str()).map(str::to_string);
+        let text_key = |key: &str, problems: &mut Vec<Problem>| match t.get(key) {
+            None => None,
+            Some(toml::Value::String(s)) => Some(s.clone()),
+            Some(other) => {
                 problems.push(mk(
                     Rule::Type,
-                    "`source` must be a key or a list of keys".into(),
+                    format!(
+                        "`{key}` of `{name}` must be a string, found {}",
+                        other.type_str()
+                    ),
                 ));
-                Vec::new()
+                None
             }
         };
-        let note = t.get("note").and_then(|v| v.as_str()).map(str::to_string);
-        let num = |v: &toml::Value| -> Option<f64> {
-            match v {
-                toml::Value::Float(x) => Some(*x),
-                toml::Value::Integer(i) => Some(*i as f64),
-                _ => None,
+        let at = text_key("at", problems);
+        let derivation = text_key("derivation", problems);
+        let derived = match t.get("derived") {
+            None => false,
+            Some(toml::Value::Boolean(b)) => *b,
+            Some(other) => {
+                problems.push(mk(
+                    Rule::Type,
+                    format!(
+                        "`derived` of `{name}` must be true or false, found {}",
+                        other.type_str()
+                    ),
+                ));
+                false
             }
         };
+        let mut history = Vec::new();
+        match t.get("history") {
+            None => {}
+            Some(toml::Value::Array(items)) => {
+                for item in items {
+                    let Some(h) = item.as_table() else {
+                        problems.push(mk(
+                            Rule::Type,
+                            format!("each `history` entry of `{name}` must be an inline table {{ value = ..., source = ... }}"),
+                        ));
+                        continue;
+                    };
+                    for k in h.keys() {
+                        if !["value", "min", "max", "source", "note"].contains(&k.as_str()) {
+                            problems.push(mk(
+                                Rule::UnknownField,
+                                format!("unknown key `{k}` in a `history` entry of `{name}` (value, min, max, source, note)"),
+                            ));
+                        }
+                    }
+                    let value = match (h.get("value"), h.get("min"), h.get("max")) {
+                        (Some(v), None, None) => toml_scalar(v),
+                        (None, lo, hi) if lo.is_some() || hi.is_some() => Some(Value::Range {
+                            min: lo.and_then(num),
+                            max: hi.and_then(num),
+                        }),
+                        _ => None,
+                    };
+                    let Some(value) = value else {
+                        problems.push(mk(
+                            Rule::MissingField,
+                            format!(
+                                "a `history` entry of `{name}` needs a `value` (or `min`/`max`)"
+                            ),
+                        ));
+                        continue;
+                    };
+                    let sources =
+                        source_keys(h.get("source"), &mut |m| problems.push(mk(Rule::Type, m)));
+                    history.push(Earlier {
+                        value,
+                        sources,
+                        note: h.get("note").and_then(|v| v.as_str()).map(str::to_string),
+                    });
+                }
+            }
+            Some(other) => problems.push(mk(
+                Rule::Type,
+                format!(
+                    "`history` of `{name}` must be a list of inline tables, found {}",
+                    other.type_str()
+                ),
+            )),
+        }
         let value = match (t.get("value"), t.get("min"), t.get("max")) {
             (Some(v), None, None) => match (spec.field_type, v) {
                 (FieldType::Number, v) if num(v).is_some() => num(v).map(Value::Number),
@@ -568,10 +683,63 @@ fn parse_values(
                 Datum {
                     value,
                     sources,
+                    at,
+                    derived,
+                    derivation,
                     note,
+                    history,
                 },
             );
         }
     }
     out
+}
+
+/// Keys a value may carry.
+pub const VALUE_KEYS: [&str; 9] = [
+    "value",
+    "min",
+    "max",
+    "source",
+    "at",
+    "derived",
+    "derivation",
+    "note",
+    "history",
+];
+
+fn num(v: &toml::Value) -> Option<f64> {
+    match v {
+        toml::Value::Float(x) => Some(*x),
+        toml::Value::Integer(i) => Some(*i as f64),
+        _ => None,
+    }
+}
+
+/// A TOML scalar as a value, keeping its own type (history entries are not typed by the
+/// vocabulary: they record what a record used to say).
+fn toml_scalar(v: &toml::Value) -> Option<Value> {
+    match v {
+        toml::Value::Float(x) => Some(Value::Number(*x)),
+        toml::Value::Integer(i) => Some(Value::Integer(*i)),
+        toml::Value::String(s) => Some(Value::Text(s.clone())),
+        toml::Value::Boolean(b) => Some(Value::Bool(*b)),
+        _ => None,
+    }
+}
+
+/// `source = "key"` or `source = ["a", "b"]`.
+fn source_keys(raw: Option<&toml::Value>, bad: &mut dyn FnMut(String)) -> Vec<String> {
+    match raw {
+        None => Vec::new(),
+        Some(toml::Value::String(s)) => vec![s.clone()],
+        Some(toml::Value::Array(a)) if a.iter().all(|v| v.is_str()) => a
+            .iter()
+            .filter_map(|v| v.as_str().map(str::to_string))
+            .collect(),
+        Some(_) => {
+            bad("`source` must be a key or a list of keys".into());
+            Vec::new()
+        }
+    }
 }

@@ -563,6 +563,7 @@ pub fn import(bytes: &[u8], file: &str) -> Result<UpstreamImport, DatasetError> 
                         value: Value::Text(text),
                         sources: survey(),
                         note: None,
+                        ..Datum::default()
                     },
                 );
                 continue;
@@ -632,6 +633,7 @@ pub fn import(bytes: &[u8], file: &str) -> Result<UpstreamImport, DatasetError> 
                             value,
                             sources: survey(),
                             note: Some(format!("upstream text: {t}")),
+                            ..Datum::default()
                         },
                     );
                     continue;
@@ -643,6 +645,7 @@ pub fn import(bytes: &[u8], file: &str) -> Result<UpstreamImport, DatasetError> 
                     value,
                     sources: survey(),
                     note: None,
+                    ..Datum::default()
                 },
             );
         }
@@ -653,6 +656,7 @@ pub fn import(bytes: &[u8], file: &str) -> Result<UpstreamImport, DatasetError> 
                     value: Value::Text(t),
                     sources: survey(),
                     note: None,
+                    ..Datum::default()
                 },
             );
         }
@@ -663,6 +667,7 @@ pub fn import(bytes: &[u8], file: &str) -> Result<UpstreamImport, DatasetError> 
                     value: Value::Bool(class == RobotClass::FullBiped),
                     sources: survey(),
                     note: Some("from the survey's lower/full biped classification".into()),
+                    ..Datum::default()
                 },
             );
         }

@@ -56,7 +56,11 @@ pub fn validate(ds: &Dataset) -> ValidationReport {
     check_metadata(ds, &mut problems);
     for (rel, robot) in &ds.robots {
         let file = ds.files.display(rel);
-        check_record(ds, rel, &file, robot, &mut problems);
+        let text = ds
+            .files
+            .bytes(rel)
+            .and_then(|b| std::str::from_utf8(b).ok());
+        check_record(ds, rel, &file, robot, text, &mut problems);
     }
     check_duplicates(ds, &mut problems);
     check_outliers(ds, &mut problems);
@@ -121,11 +125,14 @@ fn problem(
         .line(text.and_then(|t| super::record::line_of_key(t, key)))
 }
 
-fn check_record(ds: &Dataset, rel: &str, file: &str, r: &Robot, problems: &mut Vec<Problem>) {
-    let text = ds
-        .files
-        .bytes(rel)
-        .and_then(|b| std::str::from_utf8(b).ok());
+fn check_record(
+    ds: &Dataset,
+    rel: &str,
+    file: &str,
+    r: &Robot,
+    text: Option<&str>,
+    problems: &mut Vec<Problem>,
+) {
     let mut push = |field: &str, sev, rule, msg: String| {
         problems.push(problem(file, r, field, sev, rule, msg, text))
     };
@@ -245,7 +252,29 @@ fn check_record(ds: &Dataset, rel: &str, file: &str, r: &Robot, problems: &mut V
                 },
             );
         }
-        for key in &d.sources {
+        if d.derived && d.derivation.as_deref().is_none_or(|x| x.trim().is_empty()) {
+            push(
+                &field,
+                Error,
+                Rule::Provenance,
+                format!(
+                    "`{name}` is marked derived but has no `derivation` note saying how it was derived from its source"
+                ),
+            );
+        }
+        if !d.derived && d.derivation.is_some() {
+            push(
+                &field,
+                Warning,
+                Rule::Provenance,
+                format!("`{name}` has a `derivation` note but is not marked `derived = true`"),
+            );
+        }
+        for key in d
+            .sources
+            .iter()
+            .chain(d.history.iter().flat_map(|h| h.sources.iter()))
+        {
             if !r.sources.iter().any(|s| &s.key == key) {
                 push(
                     &field,
@@ -376,6 +405,28 @@ fn check_record(ds: &Dataset, rel: &str, file: &str, r: &Robot, problems: &mut V
                 Error,
                 Rule::Definition,
                 format!("mass_max {hi} kg is below mass {m} kg"),
+            );
+        }
+    }
+    // An average needs both ends: "min 20, average 30, no max" is not an average of
+    // anything reported (the survey's average column filled from one bound and a guess).
+    if let Some(m) = mass {
+        let (lo, hi) = (r.number("mass_min_kg"), r.number("mass_max_kg"));
+        let one = match (lo, hi) {
+            (Some(b), None) => Some(("mass_min_kg", "mass_max_kg", b)),
+            (None, Some(b)) => Some(("mass_max_kg", "mass_min_kg", b)),
+            _ => None,
+        };
+        if let Some((given, absent, b)) = one
+            && (m - b).abs() > 1e-9 * m.abs().max(b.abs())
+        {
+            push(
+                "values.mass_kg",
+                Warning,
+                Rule::Definition,
+                format!(
+                    "mass {m} kg is given as an average but only `{given}` ({b} kg) is reported, no `{absent}`: an average of one bound is not defined; give the reported mass, or both bounds"
+                ),
             );
         }
     }
@@ -652,4 +703,236 @@ fn check_releases(ds: &Dataset, problems: &mut Vec<Problem>) {
             .field("version"),
         );
     }
+}
+
+/// The fields whose values are fitted (leg length, body length, mass), in report order.
+pub const FITTED_FIELDS: [&str; 3] = ["leg_length_m", "body_length_m", "mass_kg"];
+
+/// How many fitted values cite a primary source, for one field and class (or all).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize)]
+pub struct Count {
+    /// Fitted values (robots with fit = true that give the field).
+    pub values: usize,
+    /// Of those, values citing at least one primary source (not a `dataset` or `secondary`).
+    pub primary: usize,
+    /// Of those primary values, the ones marked `derived`.
+    pub derived: usize,
+}
+
+impl Count {
+    pub fn share(&self) -> f64 {
+        if self.values == 0 {
+            0.0
+        } else {
+            self.primary as f64 / self.values as f64
+        }
+    }
+    fn add(&mut self, o: Count) {
+        self.values += o.values;
+        self.primary += o.primary;
+        self.derived += o.derived;
+    }
+}
+
+/// Provenance coverage of the fitted values: per field and class, per field, and overall.
+#[derive(Debug, Clone, Default, Serialize)]
+pub struct Coverage {
+    /// (field, class) → count, classes in Table 2 order.
+    pub cells: Vec<(String, RobotClass, Count)>,
+    pub per_field: Vec<(String, Count)>,
+    pub per_class: Vec<(RobotClass, Count)>,
+    pub total: Count,
+}
+
+/// Whether a value cites a primary source of its record.
+pub fn has_primary_source(r: &Robot, d: &super::record::Datum) -> bool {
+    d.sources
+        .iter()
+        .any(|k| r.sources.iter().any(|s| &s.key == k && s.kind.is_primary()))
+}
+
+/// Provenance coverage of the fitted values of the live records.
+pub fn coverage(ds: &Dataset) -> Coverage {
+    let mut cov = Coverage::default();
+    let mut per_class: BTreeMap<RobotClass, Count> = BTreeMap::new();
+    for field in FITTED_FIELDS {
+        let mut field_total = Count::default();
+        for class in RobotClass::FITTED {
+            let mut c = Count::default();
+            for (_, r) in ds.robots.iter().filter(|(_, r)| r.fit && r.class == class) {
+                let Some(d) = r.values.get(field) else {
+                    continue;
+                };
+                c.values += 1;
+                if has_primary_source(r, d) {
+                    c.primary += 1;
+                    if d.derived {
+                        c.derived += 1;
+                    }
+                }
+            }
+            cov.cells.push((field.to_string(), class, c));
+            field_total.add(c);
+            per_class.entry(class).or_default().add(c);
+        }
+        cov.per_field.push((field.to_string(), field_total));
+        cov.total.add(field_total);
+    }
+    cov.per_class = per_class.into_iter().collect();
+    cov
+}
+
+/// The coverage as the table `survey validate` prints after the problems.
+pub fn coverage_text(cov: &Coverage) -> String {
+    let pct = |c: &Count| {
+        if c.values == 0 {
+            "    -".to_string()
+        } else {
+            format!(
+                "{:>4.0}% {:>2}/{:<2}",
+                100.0 * c.share(),
+                c.primary,
+                c.values
+            )
+        }
+    };
+    let mut out = String::from(
+        "provenance coverage: fitted values citing a primary source (paper, datasheet, web, lab, model; not the survey table)
+",
+    );
+    out.push_str(&format!("  {:<14}", "field"));
+    for class in RobotClass::FITTED {
+        out.push_str(&format!(" {:>12}", class.as_str()));
+    }
+    out.push_str(&format!(" {:>12}\n", "all"));
+    for (field, total) in &cov.per_field {
+        out.push_str(&format!("  {field:<14}"));
+        for class in RobotClass::FITTED {
+            let c = cov
+                .cells
+                .iter()
+                .find(|(f, k, _)| f == field && *k == class)
+                .map(|(_, _, c)| *c)
+                .unwrap_or_default();
+            out.push_str(&format!(" {:>12}", pct(&c)));
+        }
+        out.push_str(&format!(" {:>12}\n", pct(total)));
+    }
+    out.push_str(&format!("  {:<14}", "all fields"));
+    for class in RobotClass::FITTED {
+        let c = cov
+            .per_class
+            .iter()
+            .find(|(k, _)| *k == class)
+            .map(|(_, c)| *c)
+            .unwrap_or_default();
+        out.push_str(&format!(" {:>12}", pct(&c)));
+    }
+    out.push_str(&format!(" {:>12}\n", pct(&cov.total)));
+    out.push_str(&format!(
+        "  {} of {} fitted values ({:.1}%) cite a primary source, {} of them derived (see each value's `derivation`)\n",
+        cov.total.primary,
+        cov.total.values,
+        100.0 * cov.total.share(),
+        cov.total.derived
+    ));
+    out
+}
+
+/// Checks the rows of a frozen release against the record rules (the rules that a
+/// compiled row can break: ranges, definitions, unit slips, classes, exclusions,
+/// consistency) and its class fits for outliers: the known problems a release was frozen
+/// with (1.0.0 keeps the survey's three impossible leg lengths). Each problem names the
+/// release's CSV file and the row's line in it.
+pub fn validate_release_rows(
+    ds: &Dataset,
+    version: &str,
+) -> Result<Vec<Problem>, super::DatasetError> {
+    use super::record::{Datum, Source};
+    let table = release::load_release(ds, version)?;
+    let rel = format!("releases/{version}/{}", release::TABLE_CSV);
+    let file = ds.files.display(&rel);
+    let mut problems = Vec::new();
+    for (i, row) in table.rows.iter().enumerate() {
+        let mut values = BTreeMap::new();
+        for f in ds.vocab.compiled_fields() {
+            let Some(cell) = row.cells.get(&f.name).filter(|c| !c.is_empty()) else {
+                continue;
+            };
+            let value = match f.field_type {
+                FieldType::Number => cell.parse::<f64>().ok().map(Value::Number),
+                FieldType::Integer => cell.parse::<i64>().ok().map(Value::Integer),
+                FieldType::Bool => cell.parse::<bool>().ok().map(Value::Bool),
+                FieldType::Text => Some(Value::Text(cell.clone())),
+            };
+            let Some(value) = value else {
+                problems.push(
+                    Problem::error(
+                        &file,
+                        Rule::Type,
+                        format!("`{}` cell `{cell}` does not parse", f.name),
+                    )
+                    .robot(row.id.clone())
+                    .field(format!("values.{}", f.name))
+                    .line(Some(i + 2)),
+                );
+                continue;
+            };
+            values.insert(
+                f.name.clone(),
+                Datum::new(value, vec!["release".into()], None),
+            );
+        }
+        let robot = Robot {
+            id: row.id.clone(),
+            name: row.name.clone(),
+            class: row.class,
+            fit: row.fit,
+            exclusion: row.exclusion.clone(),
+            note: None,
+            sources: vec![Source {
+                key: "release".into(),
+                kind: SourceKind::Dataset,
+                url: Some(format!(
+                    "https://github.com/robomechanics/robot-dataset#release-{version}"
+                )),
+                title: None,
+                note: None,
+            }],
+            values,
+        };
+        let mut found = Vec::new();
+        check_record(
+            ds,
+            &format!("robots/{}.toml", row.id),
+            &file,
+            &robot,
+            None,
+            &mut found,
+        );
+        for mut p in found.into_iter().filter(|p| p.rule != Rule::FileName) {
+            p.line = Some(i + 2);
+            problems.push(p);
+        }
+    }
+    for o in crate::survey::outliers(&table, OUTLIER_T) {
+        let line = table.rows.iter().position(|r| r.id == o.id).map(|i| i + 2);
+        problems.push(
+            Problem::warning(
+                &file,
+                Rule::Outlier,
+                format!(
+                    "{} vs {}: leave-one-out studentized residual {:+.2} against the {} fit (|t| > {OUTLIER_T})",
+                    o.y, o.x, o.t, o.class
+                ),
+            )
+            .robot(o.id.clone())
+            .field(format!("values.{}", o.y_field))
+            .line(line),
+        );
+    }
+    problems.sort_by(|a, b| {
+        (a.severity, a.line, &a.field, a.rule).cmp(&(b.severity, b.line, &b.field, b.rule))
+    });
+    Ok(problems)
 }

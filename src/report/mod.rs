@@ -1,8 +1,12 @@
 //! Output formats, in one place: every command's data is rendered here as text, Markdown,
 //! LaTeX (booktabs), CSV or JSON; figures live in [`plot`].
 
-pub mod plot;
 mod crosscheck;
+mod diff;
+pub mod html;
+pub mod plot;
+
+pub use diff::diff_md;
 
 pub use crosscheck::crosscheck_md;
 

@@ -588,7 +588,7 @@ fn patch_wrench_pointwise(
     let (mut fz, mut mx, mut my) = (0.0, 0.0, 0.0);
     let mut normal_damping = 0.0;
     let (mut cxx, mut cxy, mut cyy) = (0.0, 0.0, 0.0);
-    for i in 0..n {
+    for (i, w) in weights.iter_mut().enumerate().take(n) {
         let off = p.quad_offsets[i];
         let area = p.quad_area_m2[i];
         let pe = p.quad_pressure_pa[i] * scale;
@@ -599,7 +599,7 @@ fn patch_wrench_pointwise(
             continue;
         }
         let f = pi * area;
-        weights[i] = f;
+        *w = f;
         fz += f;
         mx += off.y * f;
         my -= off.x * f;

@@ -563,7 +563,6 @@ impl Simulator {
         }
         tau[6] += torque;
         damp[(6, 6)] += torque_slope;
-        info.actuator_torque_nm = torque;
         let mut gf = GeneralizedForce::default();
         for e in self.effects.iter_mut() {
             e.generalized_force(&ctx, &mut gf);
@@ -579,6 +578,10 @@ impl Simulator {
             None => a.lu().solve(&rhs).unwrap_or_else(Vector7::zeros),
         };
         let nu_new = nu + dnu;
+        // The servo's torque is implicit in the hip rate: what the step applies is the
+        // start-of-step command plus its linear response to the rate change,
+        // τ₀ − (k_d + h·k_p)·Δq̇ (reported, so peak torque and work are what acted).
+        info.actuator_torque_nm = torque - torque_slope * dnu[6];
         let mut ns = s;
         ns.set_velocity(&nu_new);
         ns.hip_position_m += ns.hip_velocity_mps * h;

@@ -166,16 +166,16 @@ pub fn prepare_walk(design: &Design, opts: &WalkOptions) -> Result<WalkSetup, Si
             ),
         });
     }
-    if let Some(l) = opts.leg_length_m {
-        if !(LEG_LENGTH_RANGE_M.0..=LEG_LENGTH_RANGE_M.1).contains(&l) {
-            return Err(SimError::InvalidOption {
-                option: "leg_length_m".into(),
-                reason: format!(
-                    "must be in [{}, {}] m (a 1 mm to 100 m walker), got {l}",
-                    LEG_LENGTH_RANGE_M.0, LEG_LENGTH_RANGE_M.1
-                ),
-            });
-        }
+    if let Some(l) = opts.leg_length_m
+        && !(LEG_LENGTH_RANGE_M.0..=LEG_LENGTH_RANGE_M.1).contains(&l)
+    {
+        return Err(SimError::InvalidOption {
+            option: "leg_length_m".into(),
+            reason: format!(
+                "must be in [{}, {}] m (a 1 mm to 100 m walker), got {l}",
+                LEG_LENGTH_RANGE_M.0, LEG_LENGTH_RANGE_M.1
+            ),
+        });
     }
     let d = design.scaled(
         opts.leg_length_m.unwrap_or(design.geometry.leg_length_m),

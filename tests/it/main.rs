@@ -3,6 +3,7 @@
 
 mod cli;
 mod common;
+mod diff;
 mod live_dataset;
 mod load_fuzz;
 mod regression_hand;
@@ -11,6 +12,7 @@ mod sim_cli;
 mod sim_physics;
 mod sim_scaling;
 mod sim_walk;
+mod survey_html;
 mod survey_inference;
 mod table2;
 mod upstream_import;

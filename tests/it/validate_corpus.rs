@@ -193,3 +193,193 @@ fn stale_datapackage_is_a_metadata_error() {
         rep.problems
     );
 }
+
+/// Writes a record into a scratch dataset's robots/ directory.
+fn write_record(dir: &std::path::Path, id: &str, text: &str) {
+    std::fs::write(dir.join("robots").join(format!("{id}.toml")), text).expect("write record");
+}
+
+/// Provenance coverage counts, by hand: of three fitted quadrupeds, leg lengths cite a
+/// paper twice (once derived) and the survey table once; body lengths cite the survey
+/// table, a secondary restatement and a datasheet; masses cite a paper, a model file and
+/// the survey table. A robot that is not fitted is not counted.
+#[test]
+fn coverage_counts_fitted_values_with_a_primary_source() {
+    let dir = common::scratch_dataset(&[]);
+    let record = |id: &str, fit: bool, leg: &str, body: &str, mass: &str| {
+        format!(
+            r#"id = "{id}"
+name = "{id}"
+class = "quadruped"
+fit = {fit}
+{excl}
+[[sources]]
+key = "survey"
+kind = "dataset"
+url = "https://github.com/robomechanics/robot-dataset"
+
+[[sources]]
+key = "paper"
+kind = "paper"
+url = "https://example.org/paper"
+
+[[sources]]
+key = "news"
+kind = "secondary"
+url = "https://example.org/news"
+
+[[sources]]
+key = "spec"
+kind = "datasheet"
+url = "https://example.org/spec.pdf"
+
+[[sources]]
+key = "urdf"
+kind = "model"
+url = "https://example.org/robot.urdf"
+
+[values]
+leg_length_m = {leg}
+body_length_m = {body}
+mass_kg = {mass}
+"#,
+            excl = if fit {
+                ""
+            } else {
+                "exclusion = \"kept for its mass\"\n"
+            }
+        )
+    };
+    write_record(
+        dir.path(),
+        "qa",
+        &record(
+            "qa",
+            true,
+            r#"{ value = 0.3, source = "paper" }"#,
+            r#"{ value = 0.6, source = "survey" }"#,
+            r#"{ value = 9.0, source = ["survey", "paper"] }"#,
+        ),
+    );
+    write_record(
+        dir.path(),
+        "qb",
+        &record(
+            "qb",
+            true,
+            r#"{ value = 0.4, source = "paper", derived = true, derivation = "thigh + shank" }"#,
+            r#"{ value = 0.8, source = "news" }"#,
+            r#"{ value = 20.0, source = "urdf", derived = true, derivation = "sum of link masses" }"#,
+        ),
+    );
+    write_record(
+        dir.path(),
+        "qc",
+        &record(
+            "qc",
+            true,
+            r#"{ value = 0.5, source = "survey" }"#,
+            r#"{ value = 1.0, source = "spec" }"#,
+            r#"{ value = 40.0, source = "survey" }"#,
+        ),
+    );
+    write_record(
+        dir.path(),
+        "qd",
+        &record(
+            "qd",
+            false,
+            r#"{ value = 0.2, source = "paper" }"#,
+            r#"{ value = 0.5, source = "paper" }"#,
+            r#"{ value = 3.0, source = "paper" }"#,
+        ),
+    );
+    let ds = Dataset::load(DatasetFiles::from_dir(dir.path()).expect("read")).expect("load");
+    let cov = robot_survey::dataset::validate::coverage(&ds);
+    let field = |f: &str| cov.per_field.iter().find(|(n, _)| n == f).expect(f).1;
+    assert_eq!(
+        (field("leg_length_m").primary, field("leg_length_m").values),
+        (2, 3)
+    );
+    assert_eq!(
+        (
+            field("body_length_m").primary,
+            field("body_length_m").values
+        ),
+        (1, 3)
+    );
+    assert_eq!((field("mass_kg").primary, field("mass_kg").values), (2, 3));
+    assert_eq!(
+        (cov.total.primary, cov.total.values, cov.total.derived),
+        (5, 9, 2)
+    );
+    // The report names the share per field and class, and overall.
+    let out = common::survey(&["validate", "--dataset", &dir.path().display().to_string()]);
+    let text = common::stdout(&out);
+    assert!(text.contains("provenance coverage"), "{text}");
+    assert!(text.contains("5 of 9 fitted values (55.6%)"), "{text}");
+    assert!(text.contains(" 67%  2/3 "), "{text}");
+}
+
+/// `validate --release X` names the release it checked and says what it checked; with
+/// `--rows` it lists the problems the release was frozen with. Release 1.0.0 keeps the
+/// survey's three impossible leg lengths (CHANGELOG 1.1.0: BigDog 1.25 m > 1.0 m,
+/// Cheetah 3 0.68 m > 0.6 m, Mini Cheetah 0.40 m > 0.38 m) and nothing else is an error.
+#[test]
+fn validate_release_names_it_and_rows_lists_its_known_errors() {
+    let ds = common::repo().join("dataset").display().to_string();
+    let out = common::survey(&["validate", "--dataset", &ds, "--release", "1.0.0"]);
+    let text = common::stdout(&out);
+    assert_eq!(out.status.code(), Some(0), "{text}");
+    assert!(text.contains("version 1.0.0"), "{text}");
+    assert!(
+        text.contains("checked release 1.0.0: integrity only"),
+        "{text}"
+    );
+    assert!(!text.contains("version 1.1.0"), "{text}");
+
+    let out = common::survey(&[
+        "validate",
+        "--dataset",
+        &ds,
+        "--release",
+        "1.0.0",
+        "--rows",
+        "--format",
+        "json",
+    ]);
+    assert_eq!(out.status.code(), Some(1), "{}", common::stderr(&out));
+    let v: Value = serde_json::from_str(&common::stdout(&out)).expect("json");
+    let mut errors: Vec<(String, String, String)> = v
+        .as_array()
+        .expect("list")
+        .iter()
+        .filter(|p| p["severity"] == "error")
+        .map(|p| {
+            (
+                p["robot"].as_str().unwrap_or("").to_string(),
+                p["field"].as_str().unwrap_or("").to_string(),
+                p["rule"].as_str().unwrap_or("").to_string(),
+            )
+        })
+        .collect();
+    errors.sort();
+    let want = |r: &str| {
+        (
+            r.to_string(),
+            "values.leg_length_m".to_string(),
+            "definition".to_string(),
+        )
+    };
+    assert_eq!(
+        errors,
+        vec![want("bigdog"), want("cheetah-3"), want("mini-cheetah")]
+    );
+    assert!(v.as_array().expect("list").iter().all(|p| {
+        p["file"]
+            .as_str()
+            .unwrap_or("")
+            .ends_with("releases/1.0.0/robots.csv")
+            || p["rule"] == "release-integrity"
+    }));
+}

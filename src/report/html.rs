@@ -1,0 +1,630 @@
+//! The interactive survey figure: one self-contained HTML page (inline SVG, inline CSS and
+//! a small inline script; nothing fetched at view time) with the three log–log panels of
+//! Table 2. Every robot with both values of a panel is one point, coloured by class;
+//! robots excluded from the fits are grey and carry their exclusion reason. Each class's
+//! fitted power law is drawn over its data range with the confidence band of the fitted
+//! line (the OLS mean interval of [`crate::regression::predict_ols`], back-transformed).
+//!
+//! Each point is an SVG `<circle class="pt">` whose `data-*` attributes hold the robot's
+//! id, name, class, fit status, exclusion and its leg length, body length and mass as the
+//! compiled table writes them; the hover tooltip is built from those attributes.
+
+use std::fmt::Write as _;
+
+use crate::dataset::{RobotClass, SurveyRow, SurveyTable};
+use crate::regression::{self, Method};
+use crate::survey::{Group, PowerLawRow, TABLE2_PAIRS, Table2, Var, log_points};
+
+/// One robot in one panel.
+#[derive(Debug, Clone)]
+pub struct FigurePoint {
+    pub id: String,
+    pub name: String,
+    pub class: RobotClass,
+    pub fit: bool,
+    pub exclusion: Option<String>,
+    /// Leg length, body length and mass cells of the compiled table (text as released).
+    pub values: [Option<String>; 3],
+    pub x: f64,
+    pub y: f64,
+}
+
+/// A class's fitted power law in one panel, with the confidence band of the line.
+#[derive(Debug, Clone)]
+pub struct FigureLine {
+    pub class: RobotClass,
+    pub fit: PowerLawRow,
+    /// (x, lower, upper) of the band of the fitted median line (empty for MA and SMA).
+    pub band: Vec<(f64, f64, f64)>,
+    /// Data range of x the line is drawn over.
+    pub x_range: (f64, f64),
+}
+
+/// One log–log panel: a Table 2 relation.
+#[derive(Debug, Clone)]
+pub struct FigurePanel {
+    pub x: Var,
+    pub y: Var,
+    pub points: Vec<FigurePoint>,
+    pub lines: Vec<FigureLine>,
+    /// The fit over all classes (Table 2's last column), listed but not drawn.
+    pub all: Option<PowerLawRow>,
+    /// Robots without both values (or with a value a log axis cannot show): (id, name, why).
+    pub missing: Vec<(String, String, String)>,
+}
+
+/// The data of the figure, computed from the table and its Table 2 fits.
+#[derive(Debug, Clone)]
+pub struct SurveyFigure {
+    pub version: String,
+    pub sha256: String,
+    pub frozen: bool,
+    pub method: Method,
+    pub confidence: f64,
+    pub panels: Vec<FigurePanel>,
+}
+
+fn row_point(r: &SurveyRow, x: Var, y: Var) -> Result<FigurePoint, String> {
+    let get = |v: Var| -> Result<f64, String> {
+        match r.number(v.field()) {
+            None => Err(format!("no {}", v.field())),
+            Some(n) if n <= 0.0 => Err(format!("{} = {n} is not positive", v.field())),
+            Some(n) => Ok(n),
+        }
+    };
+    let (px, py) = (get(x), get(y));
+    let (px, py) = match (px, py) {
+        (Ok(a), Ok(b)) => (a, b),
+        (Err(a), Err(b)) => return Err(format!("{a}, {b}")),
+        (Err(e), _) | (_, Err(e)) => return Err(e),
+    };
+    Ok(FigurePoint {
+        id: r.id.clone(),
+        name: r.name.clone(),
+        class: r.class,
+        fit: r.fit,
+        exclusion: r.exclusion.clone(),
+        values: Var::ALL.map(|v| r.cells.get(v.field()).filter(|s| !s.is_empty()).cloned()),
+        x: px,
+        y: py,
+    })
+}
+
+/// Builds the figure: every row of the table in every panel it has values for, and each
+/// class's Table 2 line with its band (OLS only: the band is the mean interval of the
+/// OLS prediction at each x).
+pub fn survey_figure(table: &SurveyTable, t2: &Table2) -> SurveyFigure {
+    let confidence = t2.fits.first().map(|f| f.confidence).unwrap_or(0.95);
+    let panels = TABLE2_PAIRS
+        .into_iter()
+        .map(|(x, y)| {
+            let mut points = Vec::new();
+            let mut missing = Vec::new();
+            for r in &table.rows {
+                match row_point(r, x, y) {
+                    Ok(p) => points.push(p),
+                    Err(why) => missing.push((r.id.clone(), r.name.clone(), why)),
+                }
+            }
+            let lines = RobotClass::FITTED
+                .into_iter()
+                .filter_map(|c| {
+                    let g = Group::Class(c);
+                    let fit = t2
+                        .fits
+                        .iter()
+                        .find(|f| f.class == g && f.x == x && f.y == y)?
+                        .clone();
+                    let pts = log_points(table, g, x, y).ok()?;
+                    let lo = pts.x.iter().copied().fold(f64::INFINITY, f64::min);
+                    let hi = pts.x.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+                    if !(lo.is_finite() && hi.is_finite() && hi > lo) {
+                        return None;
+                    }
+                    let band = match t2.method {
+                        Method::Ols => {
+                            match regression::fit_line(&pts.lx, &pts.ly, Method::Ols, confidence) {
+                                Ok(line) => {
+                                    let steps = 48;
+                                    (0..=steps)
+                                        .filter_map(|i| {
+                                            let lx = lo.log10()
+                                                + (hi.log10() - lo.log10()) * i as f64
+                                                    / steps as f64;
+                                            let p = regression::predict_ols(&line, lx, confidence)
+                                                .ok()?;
+                                            let ci = p.mean_ci.map(|v| 10f64.powf(v));
+                                            Some((10f64.powf(lx), ci.lower, ci.upper))
+                                        })
+                                        .collect()
+                                }
+                                Err(_) => Vec::new(),
+                            }
+                        }
+                        _ => Vec::new(),
+                    };
+                    Some(FigureLine {
+                        class: c,
+                        fit,
+                        band,
+                        x_range: (lo, hi),
+                    })
+                })
+                .collect();
+            FigurePanel {
+                x,
+                y,
+                all: t2
+                    .fits
+                    .iter()
+                    .find(|f| f.class == Group::All && f.x == x && f.y == y)
+                    .cloned(),
+                points,
+                lines,
+                missing,
+            }
+        })
+        .collect();
+    SurveyFigure {
+        version: table.version.clone(),
+        sha256: table.sha256.clone(),
+        frozen: table.frozen,
+        method: t2.method,
+        confidence,
+        panels,
+    }
+}
+
+/// HTML-escapes text for element content and quoted attribute values.
+fn esc(s: &str) -> String {
+    let mut out = String::with_capacity(s.len());
+    for c in s.chars() {
+        match c {
+            '&' => out.push_str("&amp;"),
+            '<' => out.push_str("&lt;"),
+            '>' => out.push_str("&gt;"),
+            '"' => out.push_str("&quot;"),
+            '\'' => out.push_str("&#39;"),
+            c => out.push(c),
+        }
+    }
+    out
+}
+
+fn hex(c: RobotClass) -> String {
+    let rgb = super::plot::class_color(c);
+    format!("#{:02x}{:02x}{:02x}", rgb.0, rgb.1, rgb.2)
+}
+
+/// Panel geometry (SVG user units).
+const W: f64 = 440.0;
+const H: f64 = 420.0;
+const LEFT: f64 = 64.0;
+const RIGHT: f64 = 14.0;
+const TOP: f64 = 14.0;
+const BOTTOM: f64 = 46.0;
+
+/// A log10 axis: data range (log10 units) to pixels.
+struct Axis {
+    lo: f64,
+    hi: f64,
+    p0: f64,
+    p1: f64,
+}
+
+impl Axis {
+    fn new(values: impl Iterator<Item = f64>, p0: f64, p1: f64) -> Self {
+        let (mut lo, mut hi) = values
+            .filter(|v| v.is_finite() && *v > 0.0)
+            .map(f64::log10)
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| {
+                (a.min(v), b.max(v))
+            });
+        if !(lo.is_finite() && hi.is_finite()) {
+            (lo, hi) = (-2.0, 0.0);
+        }
+        let pad = ((hi - lo) * 0.06).max(0.1);
+        Axis {
+            lo: lo - pad,
+            hi: hi + pad,
+            p0,
+            p1,
+        }
+    }
+    fn px(&self, v: f64) -> f64 {
+        self.p0 + (v.log10() - self.lo) / (self.hi - self.lo) * (self.p1 - self.p0)
+    }
+    /// (value, major) ticks: every decade, with 2 and 5 labelled when the axis spans
+    /// fewer than three decades; minor ticks at the other multiples.
+    fn ticks(&self) -> Vec<(f64, bool)> {
+        let span = self.hi - self.lo;
+        let mut out = Vec::new();
+        for e in (self.lo.floor() as i32)..=(self.hi.ceil() as i32) {
+            for m in 1..10 {
+                let v = f64::from(m) * 10f64.powi(e);
+                let lv = v.log10();
+                if lv < self.lo || lv > self.hi {
+                    continue;
+                }
+                let major = m == 1 || (span < 3.0 && (m == 2 || m == 5));
+                out.push((v, major));
+            }
+        }
+        out
+    }
+}
+
+fn tick_label(v: f64) -> String {
+    let s = super::sig(v);
+    if s.contains('.') {
+        s.trim_end_matches('0').trim_end_matches('.').to_string()
+    } else {
+        s
+    }
+}
+
+fn var_label(v: Var) -> &'static str {
+    match v {
+        Var::LegLength => "leg length L [m]",
+        Var::BodyLength => "body length L_B [m]",
+        Var::Mass => "mass m [kg]",
+    }
+}
+
+fn title_case(v: Var) -> &'static str {
+    match v {
+        Var::LegLength => "Leg length",
+        Var::BodyLength => "Body length",
+        Var::Mass => "Mass",
+    }
+}
+
+fn panel_svg(out: &mut String, index: usize, p: &FigurePanel, confidence: f64) {
+    let xa = Axis::new(
+        p.points
+            .iter()
+            .map(|q| q.x)
+            .chain(p.lines.iter().flat_map(|l| [l.x_range.0, l.x_range.1])),
+        LEFT,
+        W - RIGHT,
+    );
+    let ya = Axis::new(
+        p.points.iter().map(|q| q.y).chain(
+            p.lines
+                .iter()
+                .flat_map(|l| l.band.iter().flat_map(|b| [b.1, b.2])),
+        ),
+        H - BOTTOM,
+        TOP,
+    );
+    let rel = format!("{} ∝ {}^b", p.y.symbol(), p.x.symbol());
+    let _ = write!(
+        out,
+        "<figure class=\"panel\" id=\"panel-{index}\">\n<figcaption>{} vs {}: {}</figcaption>\n<svg class=\"plot\" viewBox=\"0 0 {W} {H}\" role=\"img\" aria-label=\"{} against {}, log–log\" data-x=\"{}\" data-y=\"{}\" data-relation=\"{}\">\n",
+        title_case(p.y),
+        p.x.as_str().replace('_', " "),
+        esc(&rel),
+        esc(var_label(p.y)),
+        esc(var_label(p.x)),
+        p.x.as_str(),
+        p.y.as_str(),
+        esc(&rel)
+    );
+    let _ = writeln!(
+        out,
+        "<defs><clipPath id=\"clip-{index}\"><rect x=\"{LEFT}\" y=\"{TOP}\" width=\"{}\" height=\"{}\"/></clipPath></defs>",
+        W - LEFT - RIGHT,
+        H - TOP - BOTTOM
+    );
+    // Grid and ticks.
+    out.push_str("<g class=\"grid\">\n");
+    for (v, major) in xa.ticks() {
+        let x = xa.px(v);
+        let _ = writeln!(
+            out,
+            "<line x1=\"{x:.2}\" y1=\"{TOP}\" x2=\"{x:.2}\" y2=\"{:.2}\" class=\"{}\"/>",
+            H - BOTTOM,
+            if major { "major" } else { "minor" }
+        );
+        if major {
+            let _ = writeln!(
+                out,
+                "<text x=\"{x:.2}\" y=\"{:.2}\" class=\"tick\" text-anchor=\"middle\">{}</text>",
+                H - BOTTOM + 16.0,
+                tick_label(v)
+            );
+        }
+    }
+    for (v, major) in ya.ticks() {
+        let y = ya.px(v);
+        let _ = writeln!(
+            out,
+            "<line x1=\"{LEFT}\" y1=\"{y:.2}\" x2=\"{:.2}\" y2=\"{y:.2}\" class=\"{}\"/>",
+            W - RIGHT,
+            if major { "major" } else { "minor" }
+        );
+        if major {
+            let _ = writeln!(
+                out,
+                "<text x=\"{:.2}\" y=\"{:.2}\" class=\"tick\" text-anchor=\"end\">{}</text>",
+                LEFT - 6.0,
+                y + 4.0,
+                tick_label(v)
+            );
+        }
+    }
+    out.push_str("</g>\n");
+    let _ = writeln!(
+        out,
+        "<rect class=\"frame\" x=\"{LEFT}\" y=\"{TOP}\" width=\"{}\" height=\"{}\"/>",
+        W - LEFT - RIGHT,
+        H - TOP - BOTTOM
+    );
+    let _ = writeln!(
+        out,
+        "<text class=\"axis\" x=\"{:.1}\" y=\"{:.1}\" text-anchor=\"middle\">{}</text>",
+        (LEFT + W - RIGHT) / 2.0,
+        H - 8.0,
+        esc(var_label(p.x))
+    );
+    let _ = writeln!(
+        out,
+        "<text class=\"axis\" transform=\"translate(16 {:.1}) rotate(-90)\" text-anchor=\"middle\">{}</text>",
+        (TOP + H - BOTTOM) / 2.0,
+        esc(var_label(p.y))
+    );
+    // Bands and lines, clipped to the plot area.
+    let _ = writeln!(out, "<g clip-path=\"url(#clip-{index})\">");
+    for l in &p.lines {
+        let color = hex(l.class);
+        if !l.band.is_empty() {
+            let mut d = String::new();
+            for (i, (x, _, hi)) in l.band.iter().enumerate() {
+                let _ = write!(
+                    d,
+                    "{}{:.2},{:.2}",
+                    if i == 0 { "M" } else { " L" },
+                    xa.px(*x),
+                    ya.px(*hi)
+                );
+            }
+            for (x, lo, _) in l.band.iter().rev() {
+                let _ = write!(d, " L{:.2},{:.2}", xa.px(*x), ya.px(*lo));
+            }
+            d.push_str(" Z");
+            let _ = writeln!(
+                out,
+                "<path class=\"band\" data-class=\"{}\" d=\"{d}\" fill=\"{color}\"><title>{} {:.0}% confidence band of the fitted line</title></path>",
+                l.class.as_str(),
+                esc(l.class.label()),
+                confidence * 100.0
+            );
+        }
+        let (x0, x1) = l.x_range;
+        let _ = writeln!(
+            out,
+            "<line class=\"fit\" data-class=\"{}\" data-a=\"{}\" data-b=\"{}\" x1=\"{:.2}\" y1=\"{:.2}\" x2=\"{:.2}\" y2=\"{:.2}\" stroke=\"{color}\"><title>{}: {} = {:.4}·{}^{:.3}, R² = {:.3}, n = {}</title></line>",
+            l.class.as_str(),
+            l.fit.a,
+            l.fit.b,
+            xa.px(x0),
+            ya.px(l.fit.a * x0.powf(l.fit.b)),
+            xa.px(x1),
+            ya.px(l.fit.a * x1.powf(l.fit.b)),
+            esc(l.class.label()),
+            p.y.symbol(),
+            l.fit.a,
+            p.x.symbol(),
+            l.fit.b,
+            l.fit.r2,
+            l.fit.n
+        );
+    }
+    out.push_str("</g>\n");
+    // Points: excluded (grey) first, fitted on top.
+    let mut order: Vec<&FigurePoint> = p.points.iter().collect();
+    order.sort_by_key(|q| q.fit);
+    out.push_str("<g class=\"points\">\n");
+    for q in order {
+        let fill = if q.fit {
+            hex(q.class)
+        } else {
+            "#b4b4b4".to_string()
+        };
+        let v = |i: usize| q.values[i].as_deref().unwrap_or("");
+        let _ = writeln!(
+            out,
+            "<circle class=\"pt{}\" tabindex=\"0\" cx=\"{:.2}\" cy=\"{:.2}\" r=\"{}\" fill=\"{fill}\" data-id=\"{}\" data-name=\"{}\" data-class=\"{}\" data-class-label=\"{}\" data-fit=\"{}\" data-exclusion=\"{}\" data-leg-length-m=\"{}\" data-body-length-m=\"{}\" data-mass-kg=\"{}\"/>",
+            if q.fit { "" } else { " excluded" },
+            xa.px(q.x),
+            ya.px(q.y),
+            if q.fit { 4.5 } else { 4.0 },
+            esc(&q.id),
+            esc(&q.name),
+            q.class.as_str(),
+            esc(q.class.label()),
+            q.fit,
+            esc(q.exclusion.as_deref().unwrap_or("")),
+            esc(v(0)),
+            esc(v(1)),
+            esc(v(2)),
+        );
+    }
+    out.push_str("</g>\n</svg>\n");
+    // The fits of the panel, as a compact key.
+    out.push_str("<ul class=\"fits\">\n");
+    for l in &p.lines {
+        let _ = writeln!(
+            out,
+            "<li><span class=\"swatch\" style=\"background:{}\"></span>{}: b = {:.2} [{:.2}, {:.2}], R² = {:.3}, n = {}</li>",
+            hex(l.class),
+            esc(l.class.label()),
+            l.fit.b,
+            l.fit.b_ci[0],
+            l.fit.b_ci[1],
+            l.fit.r2,
+            l.fit.n
+        );
+    }
+    if let Some(f) = &p.all {
+        let _ = writeln!(
+            out,
+            "<li><span class=\"swatch\"></span>All classes (not drawn): b = {:.2} [{:.2}, {:.2}], R² = {:.3}, n = {}</li>",
+            f.b, f.b_ci[0], f.b_ci[1], f.r2, f.n
+        );
+    }
+    out.push_str("</ul>\n");
+    if !p.missing.is_empty() {
+        let _ = writeln!(
+            out,
+            "<details class=\"missing\"><summary>{} robot(s) not in this panel (missing value)</summary><ul>",
+            p.missing.len()
+        );
+        for (id, name, why) in &p.missing {
+            let _ = writeln!(
+                out,
+                "<li data-id=\"{}\">{} <span class=\"why\">({})</span></li>",
+                esc(id),
+                esc(name),
+                esc(why)
+            );
+        }
+        out.push_str("</ul></details>\n");
+    }
+    out.push_str("</figure>\n");
+}
+
+const STYLE: &str = r#"
+body { font-family: "DejaVu Sans", "Helvetica Neue", Arial, sans-serif; margin: 18px 24px; color: #222; }
+h1 { font-size: 20px; margin: 0 0 4px; }
+p.meta { font-size: 13px; color: #555; margin: 0 0 10px; }
+.legend { font-size: 13px; margin: 0 0 8px; display: flex; flex-wrap: wrap; gap: 14px; align-items: center; }
+.legend span { display: inline-flex; align-items: center; gap: 5px; }
+.dot { width: 10px; height: 10px; border-radius: 50%; display: inline-block; }
+.panels { display: grid; grid-template-columns: repeat(3, minmax(0, 1fr)); gap: 12px; max-width: 1400px; }
+@media (max-width: 900px) { .panels { grid-template-columns: minmax(0, 1fr); max-width: 560px; } }
+figure.panel { margin: 0; min-width: 0; }
+figcaption { font-weight: bold; font-size: 15px; text-align: center; margin-bottom: 2px; }
+svg.plot { width: 100%; height: auto; display: block; }
+.grid line.major { stroke: #d0d0d0; stroke-width: 1; }
+.grid line.minor { stroke: #ededed; stroke-width: 1; }
+text.tick { font-size: 11px; fill: #444; }
+text.axis { font-size: 13px; fill: #222; }
+rect.frame { fill: none; stroke: #666; stroke-width: 1; }
+path.band { fill-opacity: 0.16; stroke: none; }
+line.fit { stroke-width: 2; }
+circle.pt { stroke: #fff; stroke-width: 0.8; cursor: pointer; }
+circle.pt.excluded { stroke: #777; stroke-width: 0.8; fill-opacity: 0.75; }
+circle.pt:hover, circle.pt:focus, circle.pt.hi { stroke: #000; stroke-width: 2; outline: none; }
+ul.fits { list-style: none; padding: 0; margin: 4px 0 0 12px; font-size: 12px; }
+ul.fits li { margin: 1px 0; }
+.swatch { display: inline-block; width: 14px; height: 3px; margin-right: 6px; vertical-align: middle; }
+details.missing { font-size: 12px; color: #555; margin: 4px 0 0 12px; }
+details.missing ul { margin: 2px 0; padding-left: 18px; }
+#tip { position: fixed; pointer-events: none; background: #fff; border: 1px solid #888; border-radius: 4px;
+  box-shadow: 0 2px 6px rgba(0,0,0,.2); padding: 6px 8px; font-size: 12px; line-height: 1.45; max-width: 340px; display: none; z-index: 10; }
+#tip b { font-size: 13px; }
+#tip .ex { color: #8a4b00; }
+"#;
+
+/// Tooltip: built with textContent from the point's data attributes (no HTML injection).
+/// Hovering or focusing a point also highlights the same robot in the other panels.
+const SCRIPT: &str = r#"
+(function () {
+  var tip = document.getElementById('tip');
+  function line(label, value, unit) {
+    var d = document.createElement('div');
+    d.textContent = label + ': ' + (value ? value + ' ' + unit : '–');
+    return d;
+  }
+  function show(pt, x, y) {
+    var s = pt.dataset;
+    tip.textContent = '';
+    var b = document.createElement('b');
+    b.textContent = s.name;
+    tip.appendChild(b);
+    var c = document.createElement('div');
+    c.textContent = s.classLabel + ' (' + s.id + ')';
+    tip.appendChild(c);
+    tip.appendChild(line('leg length L', s.legLengthM, 'm'));
+    tip.appendChild(line('body length L_B', s.bodyLengthM, 'm'));
+    tip.appendChild(line('mass m', s.massKg, 'kg'));
+    if (s.fit !== 'true') {
+      var e = document.createElement('div');
+      e.className = 'ex';
+      e.textContent = 'excluded from the fits: ' + (s.exclusion || 'no reason given');
+      tip.appendChild(e);
+    }
+    tip.style.display = 'block';
+    var w = tip.offsetWidth, h = tip.offsetHeight;
+    var left = x + 14, top = y + 14;
+    if (left + w > window.innerWidth - 4) left = x - w - 14;
+    if (top + h > window.innerHeight - 4) top = y - h - 14;
+    tip.style.left = Math.max(4, left) + 'px';
+    tip.style.top = Math.max(4, top) + 'px';
+    document.querySelectorAll('circle.pt').forEach(function (o) {
+      o.classList.toggle('hi', o.dataset.id === s.id);
+    });
+  }
+  function hide() {
+    tip.style.display = 'none';
+    document.querySelectorAll('circle.pt.hi').forEach(function (o) { o.classList.remove('hi'); });
+  }
+  document.querySelectorAll('circle.pt').forEach(function (pt) {
+    pt.addEventListener('mousemove', function (ev) { show(pt, ev.clientX, ev.clientY); });
+    pt.addEventListener('mouseleave', hide);
+    pt.addEventListener('focus', function () {
+      var r = pt.getBoundingClientRect();
+      show(pt, r.right, r.bottom);
+    });
+    pt.addEventListener('blur', hide);
+  });
+})();
+"#;
+
+/// The figure as one self-contained HTML page.
+pub fn survey_html(fig: &SurveyFigure) -> String {
+    let pct = fig.confidence * 100.0;
+    let mut out = String::from(
+        "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n<meta name=\"viewport\" content=\"width=device-width, initial-scale=1\">\n",
+    );
+    let _ = writeln!(
+        out,
+        "<title>Legged-robot survey, dataset {}: Table 2 power laws</title>",
+        esc(&fig.version)
+    );
+    let _ = writeln!(out, "<style>{STYLE}</style>\n</head>\n<body>");
+    let _ = writeln!(
+        out,
+        "<h1>Allometry of legged robots: the power laws of Table 2</h1>\n<p class=\"meta\">Dataset {} ({}), sha256 <code>{}</code>. {} fit of log<sub>10</sub> y on log<sub>10</sub> x per class{}. Generated by <code>survey fit --out</code>. Hover or focus a point for its values.</p>",
+        esc(&fig.version),
+        if fig.frozen {
+            "frozen release"
+        } else {
+            "live records"
+        },
+        esc(&fig.sha256),
+        fig.method.label(),
+        if fig.method == Method::Ols {
+            format!("; shaded: {pct:.0}% confidence band of the fitted line")
+        } else {
+            String::new()
+        }
+    );
+    out.push_str("<div class=\"legend\">");
+    for c in RobotClass::FITTED {
+        let _ = write!(
+            out,
+            "<span><i class=\"dot\" style=\"background:{}\"></i>{}</span>",
+            hex(c),
+            esc(c.label())
+        );
+    }
+    out.push_str("<span><i class=\"dot\" style=\"background:#b4b4b4;border:1px solid #777\"></i>excluded from the fits (any class)</span></div>\n<div class=\"panels\">\n");
+    for (i, p) in fig.panels.iter().enumerate() {
+        panel_svg(&mut out, i, p, fig.confidence);
+    }
+    out.push_str("</div>\n<div id=\"tip\" role=\"tooltip\"></div>\n");
+    let _ = writeln!(out, "<script>{SCRIPT}</script>\n</body>\n</html>");
+    out
+}
