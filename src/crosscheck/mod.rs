@@ -575,6 +575,8 @@ pub struct WalkComparison {
     pub design: String,
     pub leg_length_m: f64,
     pub drive_frequency_hz: f64,
+    /// Drake's discrete contact approximation for this walk (sap, similar, lagged).
+    pub drake_approximation: Option<String>,
     /// The project's walk.
     pub project: WalkReport,
     /// Drake's trajectory measured by the project's gait metrics.
@@ -603,11 +605,21 @@ fn one() -> f64 {
     1.0
 }
 
+/// Drake's engine settings of a walk golden (walks/STEM.json `engine`).
+#[derive(Clone, Debug, Deserialize)]
+pub struct WalkGoldenEngine {
+    /// "sap", "similar", "lagged" or "tamsi".
+    #[serde(default)]
+    pub discrete_contact_approximation: Option<String>,
+}
+
 /// How a Drake walk golden was made (walks/STEM.json, written by the harness).
 #[derive(Clone, Debug, Deserialize)]
 pub struct WalkGoldenMeta {
     pub design_file: String,
     pub options: WalkGoldenOptions,
+    #[serde(default)]
+    pub engine: Option<WalkGoldenEngine>,
 }
 
 /// Runs the project's walk for a Drake walk golden (STEM.json + STEM.csv) and measures
@@ -656,6 +668,7 @@ pub fn compare_walk(root: &Path, json_path: &Path) -> Result<WalkComparison, Cro
             .map(|s| s.to_string_lossy().into_owned())
             .unwrap_or_default(),
         design: meta.design_file,
+        drake_approximation: meta.engine.and_then(|e| e.discrete_contact_approximation),
         leg_length_m: project.leg_length_m,
         drive_frequency_hz: project.drive_frequency_hz,
         project,

@@ -38,7 +38,11 @@ pub fn crosscheck_md(c: &Crosscheck) -> String {
     }
     out.push_str("\n| walk | engine | walks | v [m/s] | step f [Hz] | roll p-p [°] | pitch p-p [°] | yaw p-p [°] |\n|---|---|---|---|---|---|---|---|\n");
     for w in &c.walks {
-        for (engine, r) in [("project", &w.project), ("Drake", &w.drake)] {
+        let drake = match &w.drake_approximation {
+            Some(a) => format!("Drake ({a})"),
+            None => "Drake".to_string(),
+        };
+        for (engine, r) in [("project", &w.project), (drake.as_str(), &w.drake)] {
             out.push_str(&format!(
                 "| {} | {} | {} | {} | {} | {} ± {} | {} ± {} | {} ± {} |\n",
                 w.name,

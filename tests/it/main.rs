@@ -4,6 +4,7 @@
 mod cli;
 mod common;
 mod diff;
+mod drake_crosscheck;
 mod live_dataset;
 mod load_fuzz;
 mod regression_hand;
