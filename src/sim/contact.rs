@@ -535,17 +535,27 @@ pub fn patch_wrench(
         rolling_damping[(1, 0)] = -d * s[(0, 1)];
         rolling_damping[(1, 1)] = d * s[(0, 0)];
     }
+    let weights = &p.quad_weights[..p.quad_len];
+    with_friction(p, weights, params, fn_total, v_cop, omega, moment)
+        .damped(normal_damping, rolling_damping)
+}
+
+/// The normal force `fn_total` and `moment` completed with the patch friction (weighted
+/// over the quadrature points by `weights`, which sum to 1); dampings zero, set by
+/// [`PatchWrench::damped`].
+fn with_friction(
+    p: &Patch,
+    weights: &[f64],
+    params: &ContactParams,
+    fn_total: f64,
+    v_cop: &Vector3<f64>,
+    omega: &Vector3<f64>,
+    mut moment: Vector3<f64>,
+) -> PatchWrench {
     let mut force = Vector3::new(0.0, 0.0, fn_total);
     let mut friction_damping = Matrix3::zeros();
     if fn_total > 0.0 && params.friction_mu > 0.0 {
-        let (f, m_z, k) = patch_friction(
-            p,
-            &p.quad_weights[..p.quad_len],
-            params,
-            fn_total,
-            v_cop,
-            omega.z,
-        );
+        let (f, m_z, k) = patch_friction(p, weights, params, fn_total, v_cop, omega.z);
         force.x = f.x;
         force.y = f.y;
         moment.z += m_z;
@@ -554,9 +564,17 @@ pub fn patch_wrench(
     PatchWrench {
         force,
         moment,
-        normal_damping,
+        normal_damping: 0.0,
         friction_damping,
-        rolling_damping,
+        rolling_damping: Matrix3::zeros(),
+    }
+}
+
+impl PatchWrench {
+    fn damped(mut self, normal_damping: f64, rolling_damping: Matrix3<f64>) -> PatchWrench {
+        self.normal_damping = normal_damping;
+        self.rolling_damping = rolling_damping;
+        self
     }
 }
 
@@ -610,31 +628,26 @@ fn patch_wrench_pointwise(
         cxy += c * off.x * off.y;
         cyy += c * off.y * off.y;
     }
-    let mut moment = Vector3::new(mx, my, 0.0);
-    let mut force = Vector3::new(0.0, 0.0, fz);
     let mut rolling_damping = Matrix3::zeros();
     rolling_damping[(0, 0)] = cyy;
     rolling_damping[(0, 1)] = -cxy;
     rolling_damping[(1, 0)] = -cxy;
     rolling_damping[(1, 1)] = cxx;
-    let mut friction_damping = Matrix3::zeros();
-    if fz > 0.0 && params.friction_mu > 0.0 {
+    if fz > 0.0 {
         for w in weights[..n].iter_mut() {
             *w /= fz;
         }
-        let (f, m_z, k) = patch_friction(p, &weights[..n], params, fz, v_cop, omega.z);
-        force.x = f.x;
-        force.y = f.y;
-        moment.z += m_z;
-        friction_damping = k;
     }
-    PatchWrench {
-        force,
-        moment,
-        normal_damping,
-        friction_damping,
-        rolling_damping,
-    }
+    with_friction(
+        p,
+        &weights[..n],
+        params,
+        fz,
+        v_cop,
+        omega,
+        Vector3::new(mx, my, 0.0),
+    )
+    .damped(normal_damping, rolling_damping)
 }
 
 /// Regularised Coulomb friction integrated over the patch: returns the tangential force,

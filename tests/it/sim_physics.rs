@@ -126,6 +126,26 @@ fn energy_conserved_without_actuation_damping_friction() {
     );
 }
 
+/// The spherical rocker of the rocking tests: L = 0.153 m, two 0.45 kg legs with COMs at
+/// (0, ±0.03, −0.09) m and the reference leg box, both feet the same 120 mm sphere (one
+/// rocker). Returns the model, the roll inertia about the system COM I_c, the COM height h
+/// and the sphere radius R, for ω² = m g (R − h)/(I_c + m h²).
+fn spherical_rocker(contact: ContactParams) -> (Model, f64, f64, f64) {
+    let (l, r, m_leg) = (0.153, 0.12, 0.45);
+    let inertia = box_inertia(m_leg, 0.35 * l, 0.2 * l, 0.9 * l);
+    let model = two_leg_model(
+        m_leg,
+        Vector3::new(0.0, 0.03, -0.09),
+        inertia,
+        Vector3::new(0.0, 0.0, -l + r),
+        Vector3::new(r, r, r),
+        contact,
+    );
+    // Inertia about the system COM about x: Σ (I_xx + m_leg·Δy²), Δy = ±0.03.
+    let i_c = 2.0 * (inertia[(0, 0)] + m_leg * 0.03 * 0.03);
+    (model, i_c, l - 0.09, r)
+}
+
 /// Small-oscillation lateral rocking of a rigid body on a spherical foot, rolling without
 /// slip. With the COM a height h above the ground, the sphere (radius R) centre above it
 /// and I_c the inertia about the COM about the rocking axis:
@@ -136,29 +156,14 @@ fn energy_conserved_without_actuation_damping_friction() {
 /// rigid-contact formula apply; tolerance 1 %.
 #[test]
 fn rocking_frequency_on_spherical_foot() {
-    let (l, r, m_leg) = (0.153, 0.12, 0.45);
-    let com = Vector3::new(0.0, 0.03, -0.09);
-    let inertia = box_inertia(m_leg, 0.35 * l, 0.2 * l, 0.9 * l);
-    let contact = ContactParams {
+    let (model, i_c, h, r) = spherical_rocker(ContactParams {
         modulus_pa: 1e9,
         dissipation_s_per_m: 0.0,
         friction_mu: 1.0,
         stiction_speed_mps: 1e-4,
         relaxation_time_s: 0.0,
-    };
-    let model = two_leg_model(
-        m_leg,
-        com,
-        inertia,
-        Vector3::new(0.0, 0.0, -l + r),
-        Vector3::new(r, r, r),
-        contact,
-    );
-    // Analytic frequency: system COM at height h = l − 0.09; inertia about the system COM
-    // about x: Σ (I_xx + m_leg·(Δy² + Δz²)), Δy = ±0.03 (the COMs are mirror images).
-    let m = 2.0 * m_leg;
-    let h = l - 0.09;
-    let i_c = 2.0 * (inertia[(0, 0)] + m_leg * 0.03 * 0.03);
+    });
+    let (l, m) = (0.153, model.total_mass_kg());
     let omega = (m * G * (r - h) / (i_c + m * h * h)).sqrt();
     let period = std::f64::consts::TAU / omega;
 
@@ -593,27 +598,15 @@ fn kelvin_voigt_bounce_decays_as_a_linear_damper() {
 /// (measured 0.7 %).
 #[test]
 fn kelvin_voigt_rocking_decay_matches_rolling_resistance() {
-    let (l, r, m_leg, e, tau) = (0.153, 0.12, 0.45, 3e6, 0.01);
-    let com = Vector3::new(0.0, 0.03, -0.09);
-    let inertia = box_inertia(m_leg, 0.35 * l, 0.2 * l, 0.9 * l);
-    let contact = ContactParams {
+    let (e, tau) = (3e6, 0.01);
+    let (model, i_c, h, r) = spherical_rocker(ContactParams {
         modulus_pa: e,
         dissipation_s_per_m: 0.0,
         friction_mu: 1.0,
         stiction_speed_mps: 1e-4,
         relaxation_time_s: tau,
-    };
-    let model = two_leg_model(
-        m_leg,
-        com,
-        inertia,
-        Vector3::new(0.0, 0.0, -l + r),
-        Vector3::new(r, r, r),
-        contact,
-    );
-    let m = 2.0 * m_leg;
-    let h = l - 0.09;
-    let i_c = 2.0 * (inertia[(0, 0)] + m_leg * 0.03 * 0.03);
+    });
+    let (l, m) = (0.153, model.total_mass_kg());
     let i_contact = i_c + m * h * h;
     let omega = (m * G * (r - h) / i_contact).sqrt();
     let d0 = (m * G / 2.0 / (std::f64::consts::PI * e)).sqrt();
