@@ -5,6 +5,7 @@
 //! - [`regression`]: log–log power laws (OLS, MA, SMA), intervals, tests, diagnostics.
 //! - [`survey`]: the paper's analyses over a dataset (Table 2, predictions).
 //! - [`sim`]: 3D quasi-passive walker simulation; [`scaling`]: the scaling study over it.
+//! - [`study`]: searches over the simulator (minimum walking torque).
 //! - [`crosscheck`]: the simulator against Drake on identical models (goldens from tools/drake/).
 //! - [`predict`], [`inference`], [`laws`]: designer predictions, hypothesis tests, Table 1.
 //! - [`diff`]: the live records against a frozen release, for a pull request's reviewer.
@@ -20,4 +21,5 @@ pub mod regression;
 pub mod report;
 pub mod scaling;
 pub mod sim;
+pub mod study;
 pub mod survey;

@@ -30,10 +30,39 @@ pub enum SimCommand {
     /// a measurement exported in the trajectory CSV format) with the same metric code as
     /// `sim walk`.
     Analyze(AnalyzeArgs),
+    /// The minimum hip torque (servo torque limit, or bang-bang torque magnitude) at which
+    /// the design walks consistently at a size, by bracketing and bisection.
+    MinTorque(MinTorqueArgs),
     /// The Drake cross-check: run every elementary case of the goldens' cases.toml in this
     /// engine and compare with Drake's and the analytic values; compare every Drake walk
     /// golden with this engine's walk of the same design (both measured by this code).
     Crosscheck(CrosscheckArgs),
+}
+
+#[derive(Args, Debug)]
+#[command(
+    after_help = "Example:\n  survey sim min-torque --design mugatu --leg-length 0.5 --mass-law l3 --format json\n\n\
+Walks consistently = no fall and steady forward speed above the design's threshold from the \
+unperturbed start and from each of --seeds perturbed starts. The search starts at the design's \
+own torque (scaled ∝ m·g·L), halves or doubles it to bracket, then bisects to --tolerance. \
+`walks: false` means no torque up to --cap m·g·L works: the design does not walk at that size \
+with its 1× control."
+)]
+pub struct MinTorqueArgs {
+    #[command(flatten)]
+    pub run: RunArgs,
+    /// Scale the design to this leg length [m].
+    #[arg(long, value_name = "M")]
+    pub leg_length: Option<f64>,
+    /// Perturbed starts that must walk too (besides the unperturbed one).
+    #[arg(long, default_value_t = 2, value_parser = clap::value_parser!(u64).range(0..=20))]
+    pub seeds: u64,
+    /// Relative tolerance of the bisection, (hi − lo)/hi.
+    #[arg(long, default_value_t = 0.02)]
+    pub tolerance: f64,
+    /// Largest torque tried, in units of m·g·L.
+    #[arg(long, default_value_t = 2.0)]
+    pub cap: f64,
 }
 
 #[derive(Args, Debug)]
@@ -176,7 +205,29 @@ pub fn run(a: &SimArgs) -> anyhow::Result<ExitCode> {
         SimCommand::Scale(s) => scale(s),
         SimCommand::Analyze(a) => analyze(a),
         SimCommand::Crosscheck(c) => crosscheck(c),
+        SimCommand::MinTorque(m) => min_torque(m),
     }
+}
+
+fn min_torque(a: &MinTorqueArgs) -> anyhow::Result<ExitCode> {
+    let design = Design::resolve(&a.run.design)?;
+    let opts = robot_survey::study::MinTorqueOptions {
+        walk: WalkOptions {
+            leg_length_m: a.leg_length,
+            record_trajectory: false,
+            ..a.run.options()
+        },
+        seeds: a.seeds,
+        rel_tol: a.tolerance,
+        cap_over_mgl: a.cap,
+        start_nm: None,
+    };
+    let result = robot_survey::study::min_torque(&design, &opts)?;
+    print(&match a.run.format {
+        SimFormat::Json => report::json(&result)?,
+        SimFormat::Text => report::min_torque_text(&result),
+    });
+    Ok(ExitCode::SUCCESS)
 }
 
 fn crosscheck(a: &CrosscheckArgs) -> anyhow::Result<ExitCode> {

@@ -65,3 +65,35 @@ pub fn crosscheck_md(c: &Crosscheck) -> String {
     }
     out
 }
+
+/// `survey sim min-torque` as text.
+pub fn min_torque_text(r: &crate::study::MinTorqueResult) -> String {
+    let mut out = format!(
+        "{} at L = {:.4} m, m = {:.4} kg ({:?}, {:?} contact): m·g·L = {:.4e} N·m\n",
+        r.design, r.leg_length_m, r.mass_kg, r.mass_law, r.contact, r.mgl_nm
+    );
+    match (r.min_torque_nm, r.bracket_nm) {
+        (Some(t), Some([lo, hi])) => out.push_str(&format!(
+            "minimum torque       {} N·m = {:.4} m·g·L (walks at {}, not at {} N·m)\n",
+            super::sig(t),
+            t / r.mgl_nm,
+            super::sig(hi),
+            super::sig(lo)
+        )),
+        _ => out.push_str("does not walk consistently at any torque up to the cap\n"),
+    }
+    if let Some(f) = &r.failure_below {
+        out.push_str(&format!("just below it        {f}\n"));
+    }
+    if let Some(g) = &r.gait {
+        out.push_str(&format!(
+            "gait at the minimum  v = {:.4} m/s, roll {:.1}°, pitch {:.1}°, yaw {:.1}° p-p\n",
+            g.velocity_mps, g.roll_pp_deg, g.pitch_pp_deg, g.yaw_pp_deg
+        ));
+    }
+    out.push_str(&format!(
+        "walks evaluated      {}\ncriterion            {}\n",
+        r.walks_evaluated, r.criterion
+    ));
+    out
+}

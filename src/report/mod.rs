@@ -8,7 +8,7 @@ pub mod plot;
 
 pub use diff::diff_md;
 
-pub use crosscheck::crosscheck_md;
+pub use crosscheck::{crosscheck_md, min_torque_text};
 
 use serde::Serialize;
 

@@ -73,6 +73,31 @@ impl Controller {
         }
     }
 
+    /// The servo's PD command before its torque limit, with its slopes (for the implicit
+    /// step, which clamps the torque it actually applies; see `Simulator::step`); the
+    /// bang-bang and passive commands as [`Controller::command`].
+    pub fn command_unclamped(&self, t: f64, q: f64, qd: f64) -> Command {
+        match *self {
+            Controller::ServoSine {
+                amplitude_rad,
+                frequency_hz,
+                kp_nm_per_rad,
+                kd_nms_per_rad,
+                ..
+            } => {
+                let w = 2.0 * std::f64::consts::PI * frequency_hz;
+                let (s, c) = (w * t).sin_cos();
+                Command {
+                    torque_nm: -kp_nm_per_rad * (q - amplitude_rad * s)
+                        - kd_nms_per_rad * (qd - amplitude_rad * w * c),
+                    damping_nms_per_rad: kd_nms_per_rad,
+                    stiffness_nm_per_rad: kp_nm_per_rad,
+                }
+            }
+            _ => self.command(t, q, qd),
+        }
+    }
+
     /// Torque command at time t for hip angle q and rate q̇.
     pub fn command(&self, t: f64, q: f64, qd: f64) -> Command {
         match *self {

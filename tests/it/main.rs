@@ -7,6 +7,7 @@ mod diff;
 mod drake_crosscheck;
 mod live_dataset;
 mod load_fuzz;
+mod min_torque;
 mod regression_hand;
 mod regression_smatr;
 mod sim_cli;
