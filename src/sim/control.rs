@@ -94,7 +94,7 @@ impl Controller {
                     stiffness_nm_per_rad: kp_nm_per_rad,
                 }
             }
-            _ => self.command(t, q, qd),
+            Controller::BangBang { .. } | Controller::Passive => self.command(t, q, qd),
         }
     }
 
@@ -102,26 +102,14 @@ impl Controller {
     pub fn command(&self, t: f64, q: f64, qd: f64) -> Command {
         match *self {
             Controller::ServoSine {
-                amplitude_rad,
-                frequency_hz,
-                kp_nm_per_rad,
-                kd_nms_per_rad,
-                torque_limit_nm,
+                torque_limit_nm, ..
             } => {
-                let w = 2.0 * std::f64::consts::PI * frequency_hz;
-                let (s, c) = (w * t).sin_cos();
-                let q_d = amplitude_rad * s;
-                let qd_d = amplitude_rad * w * c;
-                let raw = -kp_nm_per_rad * (q - q_d) - kd_nms_per_rad * (qd - qd_d);
-                if raw.abs() <= torque_limit_nm {
-                    Command {
-                        torque_nm: raw,
-                        damping_nms_per_rad: kd_nms_per_rad,
-                        stiffness_nm_per_rad: kp_nm_per_rad,
-                    }
+                let raw = self.command_unclamped(t, q, qd);
+                if raw.torque_nm.abs() <= torque_limit_nm {
+                    raw
                 } else {
                     Command {
-                        torque_nm: torque_limit_nm.copysign(raw),
+                        torque_nm: torque_limit_nm.copysign(raw.torque_nm),
                         ..Command::default()
                     }
                 }
