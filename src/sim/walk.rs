@@ -6,7 +6,7 @@ use std::path::Path;
 use nalgebra::Matrix3;
 use serde::Serialize;
 
-use super::design::{ContactScaling, Design, GRAVITY_MPS2, MassLaw};
+use super::design::{ContactScaling, CriteriaSpec, Design, GRAVITY_MPS2, MassLaw};
 use super::error::SimError;
 use super::model::{Model, Simulator, State, StepInfo};
 
@@ -309,17 +309,7 @@ pub fn run_setup(setup: &mut WalkSetup, opts: &WalkOptions) -> Result<WalkResult
             }
             push(sim, torque, peak, work, &info, &mut samples);
             peak = 0.0;
-            let last = samples[samples.len() - 1];
-            let reason = if last.z_m < crit.fall_hip_height_over_l * l {
-                Some("hip_low")
-            } else if last.roll_deg.abs() > crit.fall_roll_deg {
-                Some("roll")
-            } else if last.pitch_deg.abs() > crit.fall_pitch_deg {
-                Some("pitch")
-            } else {
-                None
-            };
-            if let Some(r) = reason {
+            if let Some(r) = physical_fall(&samples[samples.len() - 1], crit, l) {
                 fall = Some((r.to_string(), sim.time_s));
                 break;
             }
@@ -433,6 +423,21 @@ fn cycle_range(
     (lo, hi)
 }
 
+/// The design's fall criteria on one sample: the hip below `fall_hip_height_over_l`·L, or
+/// the hip frame's |roll| or |pitch| beyond its limit (the same checks for a live run and
+/// for a trajectory recorded elsewhere).
+fn physical_fall(s: &TrajectorySample, crit: &CriteriaSpec, l: f64) -> Option<&'static str> {
+    if s.z_m < crit.fall_hip_height_over_l * l {
+        Some("hip_low")
+    } else if s.roll_deg.abs() > crit.fall_roll_deg {
+        Some("roll")
+    } else if s.pitch_deg.abs() > crit.fall_pitch_deg {
+        Some("pitch")
+    } else {
+        None
+    }
+}
+
 /// What the metrics need of the run besides its samples.
 struct RunFacts {
     drive_frequency_hz: f64,
@@ -460,16 +465,10 @@ pub fn report_from_trajectory(
         let finite = [s.x_m, s.y_m, s.z_m, s.roll_deg, s.pitch_deg, s.yaw_deg]
             .iter()
             .all(|x| x.is_finite());
-        let reason = if !finite {
-            Some("diverged")
-        } else if s.z_m < crit.fall_hip_height_over_l * l {
-            Some("hip_low")
-        } else if s.roll_deg.abs() > crit.fall_roll_deg {
-            Some("roll")
-        } else if s.pitch_deg.abs() > crit.fall_pitch_deg {
-            Some("pitch")
+        let reason = if finite {
+            physical_fall(s, crit, l)
         } else {
-            None
+            Some("diverged")
         };
         if let Some(r) = reason {
             fall = Some((r.to_string(), s.t_s));
