@@ -247,19 +247,10 @@ fn run_trace(design: &Design, case: &Case) -> Result<(Trace, Design), Crosscheck
         init.yaw_deg.to_radians(),
     );
     let r = *orientation.to_rotation_matrix().matrix();
-    let nf = r.transpose() * Vector3::z();
-    let mut hip_z = f64::NEG_INFINITY;
-    for leg in &model.legs {
-        let a = leg.foot_semi_axes_m;
-        let support =
-            (a.x * a.x * nf.x * nf.x + a.y * a.y * nf.y * nf.y + a.z * a.z * nf.z * nf.z).sqrt();
-        hip_z = hip_z.max(support - (r * leg.foot_center_m).z);
-    }
+    let mut hip_z = model.touch_height_m(&r);
     let e = model.contact.modulus_pa;
     match init.placement.as_str() {
-        "design" => {
-            hip_z -= (model.total_mass_kg() * GRAVITY_MPS2 / (std::f64::consts::PI * e)).sqrt()
-        }
+        "design" => hip_z -= model.single_foot_sinkage_m(),
         "static" => {
             let semi = model.legs[0].foot_semi_axes_m;
             let load = model.total_mass_kg() * model.gravity_mps2.z.abs() / 2.0;

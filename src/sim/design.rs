@@ -735,19 +735,8 @@ impl Design {
         }
         let orientation = UnitQuaternion::from_euler_angles(roll, pitch, yaw);
         let r = *orientation.to_rotation_matrix().matrix();
-        let weight = model.total_mass_kg() * GRAVITY_MPS2;
-        let sink = (weight / (std::f64::consts::PI * model.contact.modulus_pa)).sqrt();
-        // Lowest height of the hip for which each foot just touches; take the highest.
-        let mut hip_z = f64::NEG_INFINITY;
-        for leg in &model.legs {
-            let nf = r.transpose() * Vector3::z();
-            let a = leg.foot_semi_axes_m;
-            let support =
-                (a.x * a.x * nf.x * nf.x + a.y * a.y * nf.y * nf.y + a.z * a.z * nf.z * nf.z)
-                    .sqrt();
-            let z = support - (r * leg.foot_center_m).z;
-            hip_z = hip_z.max(z);
-        }
+        let hip_z = model.touch_height_m(&r);
+        let sink = model.single_foot_sinkage_m();
         State {
             hip_position_m: Vector3::new(0.0, 0.0, hip_z - sink),
             orientation,

@@ -395,6 +395,31 @@ impl Model {
         contact::patch_into(p, &c, &kin.rot[k], semi, e, cut.as_ref(), with_energy)
     }
 
+    /// Lowest hip height at which every foot is at or above the ground with the left leg
+    /// at orientation `r` (leg → world) and the legs together (q = 0): the highest
+    /// foot-touch height over the legs, from each ellipsoid's support distance.
+    pub fn touch_height_m(&self, r: &Matrix3<f64>) -> f64 {
+        let nf = r.transpose() * Vector3::z();
+        self.legs
+            .iter()
+            .map(|leg| {
+                let a = leg.foot_semi_axes_m;
+                let support =
+                    (a.x * a.x * nf.x * nf.x + a.y * a.y * nf.y * nf.y + a.z * a.z * nf.z * nf.z)
+                        .sqrt();
+                support - (r * leg.foot_center_m).z
+            })
+            .fold(f64::NEG_INFINITY, f64::max)
+    }
+
+    /// Static sinkage of one spherical foot carrying the whole weight, √(m g/(π E))
+    /// (F = π E δ² for δ ≪ R): how far a start is lowered below just touching.
+    pub fn single_foot_sinkage_m(&self) -> f64 {
+        (self.total_mass_kg() * super::design::GRAVITY_MPS2
+            / (std::f64::consts::PI * self.contact.modulus_pa))
+            .sqrt()
+    }
+
     /// Mechanical energy (kinetic + gravity + elastic contact + hardstop springs).
     pub fn energy(&self, s: &State) -> Energy {
         let kin = self.kinematics(s);
