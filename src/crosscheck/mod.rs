@@ -590,6 +590,9 @@ pub struct WalkGoldenOptions {
     pub relaxation_scale: f64,
     #[serde(default = "one")]
     pub time_step_scale: f64,
+    /// Initial roll of the run [deg] (None: the design's).
+    #[serde(default)]
+    pub initial_roll_deg: Option<f64>,
 }
 
 fn one() -> f64 {
@@ -613,9 +616,19 @@ pub struct WalkGoldenMeta {
     pub engine: Option<WalkGoldenEngine>,
 }
 
-/// Runs the project's walk for a Drake walk golden (STEM.json + STEM.csv) and measures
-/// both with the project's metrics.
-pub fn compare_walk(root: &Path, json_path: &Path) -> Result<WalkComparison, CrosscheckError> {
+/// A Drake walk golden, read: the design and options it was run with, and Drake's
+/// trajectory measured by the project's gait metrics.
+pub struct WalkGolden {
+    pub meta: WalkGoldenMeta,
+    /// The design with the golden's relaxation-time, time-step and initial-roll changes.
+    pub design: Design,
+    pub options: WalkOptions,
+    /// Drake's trajectory (STEM.csv) measured by [`report_from_trajectory`].
+    pub drake: WalkReport,
+}
+
+/// Reads a Drake walk golden (STEM.json + STEM.csv) and measures its trajectory.
+pub fn read_walk_golden(root: &Path, json_path: &Path) -> Result<WalkGolden, CrosscheckError> {
     let text = read(json_path)?;
     let meta: WalkGoldenMeta =
         serde_json::from_str(&text).map_err(|e| CrosscheckError::Invalid {
@@ -631,6 +644,9 @@ pub fn compare_walk(root: &Path, json_path: &Path) -> Result<WalkComparison, Cro
     let o = &meta.options;
     design.contact.relaxation_time_s *= o.relaxation_scale;
     design.numerics.time_step_s *= o.time_step_scale;
+    if let Some(roll) = o.initial_roll_deg {
+        design.initial.roll_deg = roll;
+    }
     let mass_law = match o.mass_law.as_deref() {
         None | Some("l2") => crate::sim::MassLaw::L2,
         Some("l3") => crate::sim::MassLaw::L3,
@@ -641,7 +657,7 @@ pub fn compare_walk(root: &Path, json_path: &Path) -> Result<WalkComparison, Cro
             });
         }
     };
-    let opts = WalkOptions {
+    let options = WalkOptions {
         leg_length_m: o.leg_length_m,
         mass_law,
         frequency_hz: o.frequency_hz,
@@ -649,21 +665,32 @@ pub fn compare_walk(root: &Path, json_path: &Path) -> Result<WalkComparison, Cro
         record_trajectory: false,
         ..WalkOptions::default()
     };
-    let project = simulate_walk(&design, &opts)?.report;
-    let csv = json_path.with_extension("csv");
-    let samples = read_trajectory_csv(&csv)?;
-    let drake = report_from_trajectory(&design, &opts, &samples)?;
+    let samples = read_trajectory_csv(&json_path.with_extension("csv"))?;
+    let drake = report_from_trajectory(&design, &options, &samples)?;
+    Ok(WalkGolden {
+        meta,
+        design,
+        options,
+        drake,
+    })
+}
+
+/// Runs the project's walk for a Drake walk golden (STEM.json + STEM.csv) and measures
+/// both with the project's metrics.
+pub fn compare_walk(root: &Path, json_path: &Path) -> Result<WalkComparison, CrosscheckError> {
+    let g = read_walk_golden(root, json_path)?;
+    let project = simulate_walk(&g.design, &g.options)?.report;
     Ok(WalkComparison {
         name: json_path
             .file_stem()
             .map(|s| s.to_string_lossy().into_owned())
             .unwrap_or_default(),
-        design: meta.design_file,
-        drake_approximation: meta.engine.and_then(|e| e.discrete_contact_approximation),
+        design: g.meta.design_file,
+        drake_approximation: g.meta.engine.and_then(|e| e.discrete_contact_approximation),
         leg_length_m: project.leg_length_m,
         drive_frequency_hz: project.drive_frequency_hz,
         project,
-        drake,
+        drake: g.drake,
     })
 }
 

@@ -8,7 +8,6 @@ use std::collections::BTreeMap;
 use std::path::PathBuf;
 
 use robot_survey::crosscheck::{self, Case, Measured};
-use robot_survey::sim::{Design, WalkOptions, read_trajectory_csv, report_from_trajectory};
 use serde_json::Value;
 
 use crate::common;
@@ -283,24 +282,11 @@ fn gait_metrics_agree_between_the_two_implementations() {
         if path.extension().is_none_or(|e| e != "json") || !csv.exists() {
             continue;
         }
+        let r = crosscheck::read_walk_golden(&common::repo(), &path)
+            .expect("golden reads")
+            .drake;
         let meta: Value =
             serde_json::from_str(&std::fs::read_to_string(&path).expect("read")).expect("json");
-        let design = Design::from_file(
-            &common::repo().join(meta["design_file"].as_str().expect("design_file")),
-        )
-        .expect("design");
-        let o = &meta["options"];
-        let mut design = design;
-        design.contact.relaxation_time_s *= o["relaxation_scale"].as_f64().unwrap_or(1.0);
-        design.numerics.time_step_s *= o["time_step_scale"].as_f64().unwrap_or(1.0);
-        let opts = WalkOptions {
-            leg_length_m: o["leg_length_m"].as_f64(),
-            frequency_hz: o["frequency_hz"].as_f64(),
-            duration_s: o["duration_s"].as_f64().unwrap_or(25.0),
-            ..WalkOptions::default()
-        };
-        let samples = read_trajectory_csv(&csv).expect("csv");
-        let r = report_from_trajectory(&design, &opts, &samples).expect("report");
         let py = &meta["report_from_csv"];
         assert_eq!(Some(r.walks), py["walks"].as_bool(), "{}", path.display());
         assert_eq!(
