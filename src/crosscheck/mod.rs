@@ -172,7 +172,6 @@ struct Trace {
     t: Vec<f64>,
     hip: Vec<Vector3<f64>>,
     roll_deg: Vec<f64>,
-    pitch_deg: Vec<f64>,
     hip_angle_rad: Vec<f64>,
     omega_left_w: Vec<Vector3<f64>>,
     com: Vec<Vector3<f64>>,
@@ -186,7 +185,7 @@ fn record(tr: &mut Trace, sim: &Simulator, normal: [f64; 2], feet: u8, torque: f
     let s = &sim.state;
     let model = &sim.model;
     let kin = model.kinematics(s);
-    let (roll, pitch, _) = hip_frame_attitude(model, s);
+    let (roll, _, _) = hip_frame_attitude(model, s);
     let m = model.total_mass_kg();
     let mut com = Vector3::zeros();
     let mut vcom = Vector3::zeros();
@@ -199,7 +198,6 @@ fn record(tr: &mut Trace, sim: &Simulator, normal: [f64; 2], feet: u8, torque: f
     tr.t.push(sim.time_s);
     tr.hip.push(s.hip_position_m);
     tr.roll_deg.push(roll.to_degrees());
-    tr.pitch_deg.push(pitch.to_degrees());
     tr.hip_angle_rad.push(s.hip_angle_rad);
     tr.omega_left_w.push(kin.omega_w[0]);
     tr.com.push(com / m);
@@ -554,7 +552,6 @@ pub fn run_case(root: &Path, name: &str, case: &Case) -> Result<Measured, Crossc
     } else {
         return Err(unknown());
     }
-    let _ = &tr.pitch_deg;
     Ok(m)
 }
 

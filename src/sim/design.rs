@@ -137,21 +137,6 @@ pub struct ContactSpec {
     pub relaxation_time_s: f64,
 }
 
-impl ContactSpec {
-    /// Name of the dissipation form this contact uses (for reports).
-    pub fn dissipation_form(&self) -> &'static str {
-        match (
-            self.relaxation_time_s > 0.0,
-            self.hunt_crossley_dissipation_s_per_m > 0.0,
-        ) {
-            (true, true) => "kelvin-voigt + hunt-crossley",
-            (true, false) => "kelvin-voigt",
-            (false, true) => "hunt-crossley",
-            (false, false) => "none",
-        }
-    }
-}
-
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(tag = "kind", rename_all = "snake_case", deny_unknown_fields)]
 pub enum ControlSpec {
