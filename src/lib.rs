@@ -6,6 +6,7 @@
 //! - [`survey`]: the paper's analyses over a dataset (Table 2, predictions).
 //! - [`sim`]: 3D quasi-passive walker simulation; [`scaling`]: the scaling study over it.
 //! - [`study`]: searches over the simulator (minimum walking torque).
+//! - [`gap`]: sim-to-real gap diagnosis (trials, candidate effects, fitting, benchmark).
 //! - [`crosscheck`]: the simulator against Drake on identical models (goldens from tools/drake/).
 //! - [`predict`], [`inference`], [`laws`]: designer predictions, hypothesis tests, Table 1.
 //! - [`diff`]: the live records against a frozen release, for a pull request's reviewer.
@@ -14,6 +15,7 @@
 pub mod crosscheck;
 pub mod dataset;
 pub mod diff;
+pub mod gap;
 pub mod inference;
 pub mod laws;
 pub mod predict;

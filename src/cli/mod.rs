@@ -4,6 +4,7 @@
 mod dataset_cmd;
 mod diff_cmd;
 mod fit_cmd;
+mod gap;
 mod sim;
 
 use std::path::PathBuf;
@@ -62,6 +63,9 @@ pub enum Command {
     Dataset(dataset_cmd::DatasetCmdArgs),
     /// Simulate the quasi-passive walkers (Mugatu, Zippy).
     Sim(sim::SimArgs),
+    /// The sim-to-real gap: where the simulation misses measured trials, which unmodelled
+    /// effect explains it, how far the gap shrinks (and synthetic trials to prove it).
+    Gap(gap::GapArgs),
 }
 
 /// Entry point: parse, run, map errors to exit codes.
@@ -94,6 +98,7 @@ fn run(cli: Cli) -> anyhow::Result<ExitCode> {
         Command::Laws(a) => fit_cmd::laws(&a),
         Command::Dataset(a) => dataset_cmd::run(&a),
         Command::Sim(a) => sim::run(&a),
+        Command::Gap(a) => gap::run(&a),
     }
 }
 

@@ -272,7 +272,7 @@ fn run_trace(design: &Design, case: &Case) -> Result<(Trace, Design), Crosscheck
         angular_velocity_rad_s: Vector3::new(w[0], w[1], w[2]),
         hip_rate_rad_s: 0.0,
     };
-    let effects = d.effects.iter().map(|e| e.build()).collect();
+    let effects = d.effects.iter().filter_map(|e| e.build()).collect();
     let dt = d.numerics.time_step_s;
     let mut sim = Simulator::new(model, controller, effects, state, dt);
     let mut tr = Trace::default();

@@ -37,6 +37,12 @@ pub use vocabulary::{FieldSpec, FieldType, Vocabulary};
 /// machine from any working directory.
 static BUNDLED: Dir<'_> = include_dir!("$CARGO_MANIFEST_DIR/dataset");
 
+/// A folder of the bundled dataset (e.g. `effects`, `trials`), for readers that want the
+/// compiled-in copy of their data.
+pub fn bundled_dir(sub: &str) -> Option<&'static Dir<'static>> {
+    BUNDLED.get_dir(sub)
+}
+
 /// Errors that stop a dataset from being read at all (as opposed to [`Problem`]s, which
 /// are findings about its content).
 #[derive(Debug, thiserror::Error)]

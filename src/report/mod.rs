@@ -3,6 +3,7 @@
 
 mod crosscheck;
 mod diff;
+pub mod gap;
 pub mod html;
 pub mod plot;
 

@@ -13,7 +13,7 @@ use crate::survey::{Group, Table2, Var, points};
 static FONT: Once = Once::new();
 const FONT_BYTES: &[u8] = include_bytes!("../../assets/fonts/DejaVuSans.ttf");
 
-fn register_font() {
+pub(crate) fn register_font() {
     FONT.call_once(|| {
         // The bytes are a known-good TTF compiled in; failure would be a build defect.
         let _ = plotters::style::register_font("sans-serif", FontStyle::Normal, FONT_BYTES);

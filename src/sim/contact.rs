@@ -47,6 +47,12 @@
 //! integrated by a polar quadrature rule (Gauss–Legendre in radius × uniform in angle)
 //! whose weights are normalised to the closed-form normal force; this yields the friction
 //! force and the torsional (spin) moment that point contact lacks.
+//!
+//! An optional rolling resistance (the `rolling_resistance` effect, length e) models what
+//! the pressure field lacks, e.g. a floor covering's hysteresis: the centre of pressure
+//! shifts by e ahead of the rolling direction, a moment −e·Fₙ·ω_t/|ω_t| in the ground plane
+//! (regularised below the rate ω_s and capped as the Hunt–Crossley moment), in both
+//! dissipation forms.
 
 use nalgebra::{Matrix2, Matrix3, Vector2, Vector3};
 use serde::{Deserialize, Serialize};
@@ -64,6 +70,14 @@ pub struct ContactParams {
     pub stiction_speed_mps: f64,
     /// Kelvin–Voigt relaxation time τ_d [s] (Drake SAP's `relaxation_time`; 0: none).
     pub relaxation_time_s: f64,
+    /// Rolling-resistance length e [m]: the centre of pressure shifts this far ahead of
+    /// the rolling direction (0: none; the `rolling_resistance` effect sets it).
+    #[serde(default)]
+    pub rolling_resistance_m: f64,
+    /// Regularisation rate ω_s of the rolling resistance [rad/s]: below it the moment is
+    /// viscous, as friction below the stiction speed (`Design::model`: v_s/L).
+    #[serde(default)]
+    pub rolling_resistance_rate_rad_s: f64,
 }
 
 /// Radial Gauss–Legendre nodes/weights on ξ ∈ [0, 1] (3 points).
@@ -535,6 +549,14 @@ pub fn patch_wrench(
         rolling_damping[(1, 0)] = -d * s[(0, 1)];
         rolling_damping[(1, 1)] = d * s[(0, 0)];
     }
+    add_rolling_resistance(
+        p,
+        params,
+        fn_total,
+        omega,
+        &mut moment,
+        &mut rolling_damping,
+    );
     let weights = &p.quad_weights[..p.quad_len];
     with_friction(p, weights, params, fn_total, v_cop, omega, moment)
         .damped(normal_damping, rolling_damping)
@@ -638,16 +660,47 @@ fn patch_wrench_pointwise(
             *w /= fz;
         }
     }
-    with_friction(
-        p,
-        &weights[..n],
-        params,
-        fz,
-        v_cop,
-        omega,
-        Vector3::new(mx, my, 0.0),
-    )
-    .damped(normal_damping, rolling_damping)
+    let mut moment = Vector3::new(mx, my, 0.0);
+    add_rolling_resistance(p, params, fz, omega, &mut moment, &mut rolling_damping);
+    with_friction(p, &weights[..n], params, fz, v_cop, omega, moment)
+        .damped(normal_damping, rolling_damping)
+}
+
+/// Adds the rolling-resistance moment of the `rolling_resistance` effect: the centre of
+/// pressure shifted by e ahead of the rolling direction, M = −e·Fₙ·ω_t/√(|ω_t|² + ω_s²)
+/// in the ground plane (ω_t = (ω_x, ω_y)), and its frozen-coefficient secant e·Fₙ/s on the
+/// (x, y) diagonal of −∂M/∂ω: as for friction, the implicit step can then stop a rolling
+/// foot but never reverse it. No-op while e = 0, so the plain model is unchanged.
+fn add_rolling_resistance(
+    p: &Patch,
+    params: &ContactParams,
+    fn_total: f64,
+    omega: &Vector3<f64>,
+    moment: &mut Vector3<f64>,
+    rolling_damping: &mut Matrix3<f64>,
+) {
+    let e = params.rolling_resistance_m;
+    if !(e > 0.0 && fn_total > 0.0) {
+        return;
+    }
+    let ws = params.rolling_resistance_rate_rad_s;
+    let wt2 = omega.x * omega.x + omega.y * omega.y;
+    let s = (wt2 + ws * ws).sqrt();
+    if s == 0.0 {
+        // At rest without regularisation: no rolling direction, no moment.
+        return;
+    }
+    let mut c = e * fn_total / s;
+    // The shifted centre of pressure stays inside the patch: |M| ≤ Fₙ·inner radius.
+    let m = c * wt2.sqrt();
+    let cap = fn_total * p.inner_radius_m;
+    if m > cap {
+        c *= cap / m;
+    }
+    moment.x -= c * omega.x;
+    moment.y -= c * omega.y;
+    rolling_damping[(0, 0)] += c;
+    rolling_damping[(1, 1)] += c;
 }
 
 /// Regularised Coulomb friction integrated over the patch: returns the tangential force,

@@ -599,12 +599,13 @@ impl Design {
         }
         d.numerics.time_step_s *= time;
         for e in d.effects.iter_mut() {
-            *e = e.scaled(s, mu);
+            *e = e.scaled(s, mu, contact_scaling);
         }
         Ok(d)
     }
 
-    /// The rigid-body model.
+    /// The rigid-body model, with the contact effects of `effects` applied to its contact
+    /// parameters.
     pub fn model(&self) -> Model {
         let l = self.geometry.leg_length_m;
         let g = &self.geometry;
@@ -643,15 +644,23 @@ impl Design {
         let mgl = self.mgl_nm();
         let tl = (l / GRAVITY_MPS2).sqrt();
         let slope = self.ground.slope_deg.to_radians();
+        let mut contact = ContactParams {
+            modulus_pa: self.contact.hydroelastic_modulus_pa,
+            dissipation_s_per_m: self.contact.hunt_crossley_dissipation_s_per_m,
+            friction_mu: self.contact.friction_mu,
+            stiction_speed_mps: self.contact.stiction_speed_mps,
+            relaxation_time_s: self.contact.relaxation_time_s,
+            rolling_resistance_m: 0.0,
+            // The angular counterpart of the stiction speed: a foot rolling on its leg
+            // (radius ~ L) at v_s.
+            rolling_resistance_rate_rad_s: self.contact.stiction_speed_mps / l,
+        };
+        for e in &self.effects {
+            e.apply_to_contact(&mut contact, l);
+        }
         Model {
             legs: [leg(1.0), leg(-1.0)],
-            contact: ContactParams {
-                modulus_pa: self.contact.hydroelastic_modulus_pa,
-                dissipation_s_per_m: self.contact.hunt_crossley_dissipation_s_per_m,
-                friction_mu: self.contact.friction_mu,
-                stiction_speed_mps: self.contact.stiction_speed_mps,
-                relaxation_time_s: self.contact.relaxation_time_s,
-            },
+            contact,
             hardstop: self.hardstop.as_ref().map(|h| Hardstop {
                 limit_rad: h.limit_deg.to_radians(),
                 stiffness_nm_per_rad: h.stiffness_over_mgl * mgl,

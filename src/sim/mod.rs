@@ -8,7 +8,10 @@
 //!   regularised Coulomb friction with torsional moment.
 //! * [`control`]: position servo (Mugatu) and bang-bang torque with hardstops (Zippy).
 //! * [`design`]: designs as TOML data, scaling with leg length.
-//! * [`effects`]: optional physical effects (hip damping, …) as data-described plug-ins.
+//! * [`effects`]: optional unmodelled physics as data, switched on per design: hip effects
+//!   (viscous and Coulomb friction, motor torque–speed line, actuation latency, backlash) as
+//!   plug-ins, contact effects (friction coefficient, soft ground, rolling resistance) through
+//!   the contact parameters.
 //! * [`walk`]: running a walk and its gait metrics ([`WalkReport`]).
 //! * [`plot`]: SVG plot of a walk.
 //!
@@ -28,7 +31,7 @@ pub use contact::{
 };
 pub use control::{Command, Controller};
 pub use design::{BUILTIN_DESIGNS, ContactScaling, Design, GRAVITY_MPS2, MassLaw};
-pub use effects::{Effect, EffectContext, EffectFile, EffectSpec, GeneralizedForce};
+pub use effects::{Effect, EffectContext, EffectSpec, GeneralizedForce};
 pub use error::SimError;
 pub use model::{
     Energy, FootSection, Hardstop, Kinematics, Leg, Matrix7, Model, Simulator, State, StepInfo,

@@ -203,7 +203,7 @@ pub fn prepare_walk(design: &Design, opts: &WalkOptions) -> Result<WalkSetup, Si
         controller.set_frequency_hz(f);
     }
     let state = d.initial_state(&model, opts.seed);
-    let effects = d.effects.iter().map(|e| e.build()).collect();
+    let effects = d.effects.iter().filter_map(|e| e.build()).collect();
     let dt = d.numerics.time_step_s;
     let limit = stable_time_step_s(&d);
     if dt > limit {

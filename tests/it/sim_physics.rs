@@ -56,6 +56,8 @@ fn frictionless(modulus_pa: f64) -> ContactParams {
         friction_mu: 0.0,
         stiction_speed_mps: 1e-3,
         relaxation_time_s: 0.0,
+        rolling_resistance_m: 0.0,
+        rolling_resistance_rate_rad_s: 0.0,
     }
 }
 
@@ -162,6 +164,8 @@ fn rocking_frequency_on_spherical_foot() {
         friction_mu: 1.0,
         stiction_speed_mps: 1e-4,
         relaxation_time_s: 0.0,
+        rolling_resistance_m: 0.0,
+        rolling_resistance_rate_rad_s: 0.0,
     });
     let (l, m) = (0.153, model.total_mass_kg());
     let omega = (m * G * (r - h) / (i_c + m * h * h)).sqrt();
@@ -217,6 +221,8 @@ fn sphere_rolls_down_incline_at_five_sevenths_g_sin_theta() {
         friction_mu: 1.0,
         stiction_speed_mps: 1e-4,
         relaxation_time_s: 0.0,
+        rolling_resistance_m: 0.0,
+        rolling_resistance_rate_rad_s: 0.0,
     };
     let centre = Vector3::new(0.0, 0.0, -0.1);
     let mut model = two_leg_model(m_leg, centre, i, centre, Vector3::new(r, r, r), contact);
@@ -416,6 +422,8 @@ fn static_penetration_matches_contact_law() {
         friction_mu: 0.8,
         stiction_speed_mps: 1e-3,
         relaxation_time_s: 0.0,
+        rolling_resistance_m: 0.0,
+        rolling_resistance_rate_rad_s: 0.0,
     };
     // Both COMs directly above the (coincident) foot centres: no rocking torque.
     let model = two_leg_model(
@@ -489,12 +497,12 @@ fn hip_viscous_damping_dissipates_its_work() {
     s.angular_velocity_rad_s = Vector3::new(1.0, 2.0, -1.5);
     s.hip_rate_rad_s = 6.0;
     let c = 0.02;
-    let effects: Vec<Box<dyn Effect>> = vec![
-        EffectSpec::HipViscousDamping {
-            damping_nms_per_rad: c,
-        }
-        .build(),
-    ];
+    let effects: Vec<Box<dyn Effect>> = [EffectSpec::HipViscousDamping {
+        damping_nms_per_rad: c,
+    }]
+    .iter()
+    .filter_map(|e| e.build())
+    .collect();
     let energy0 = model.energy(&s);
     let e0 = energy0.total_j();
     // Small step: the integrator's own O(h) energy error must be ≪ 1 % of the loss.
@@ -545,6 +553,8 @@ fn kelvin_voigt_bounce_decays_as_a_linear_damper() {
         friction_mu: 0.0,
         stiction_speed_mps: 1e-4,
         relaxation_time_s: tau,
+        rolling_resistance_m: 0.0,
+        rolling_resistance_rate_rad_s: 0.0,
     };
     let model = two_leg_model(
         m_leg,
@@ -605,6 +615,8 @@ fn kelvin_voigt_rocking_decay_matches_rolling_resistance() {
         friction_mu: 1.0,
         stiction_speed_mps: 1e-4,
         relaxation_time_s: tau,
+        rolling_resistance_m: 0.0,
+        rolling_resistance_rate_rad_s: 0.0,
     });
     let (l, m) = (0.153, model.total_mass_kg());
     let i_contact = i_c + m * h * h;

@@ -1,0 +1,232 @@
+//! A trial condition through the simulator: the design scaled to the trial's size and
+//! overridden by its condition columns, plus (optionally) one candidate effect.
+
+use std::path::Path;
+
+use rayon::prelude::*;
+
+use super::error::GapError;
+use super::library::{EffectLibrary, EffectSetting};
+use super::trials::{Metric, Trial, TrialSet};
+use crate::sim::design::ControlSpec;
+use crate::sim::{ContactScaling, Design, MassLaw, WalkOptions, simulate_walk};
+
+/// Drive cycles simulated per trial: the gaits converge within 2–5 cycles (Poincaré
+/// section of `sim walk`), and the metrics average over the rest.
+pub const CYCLES_PER_TRIAL: f64 = 16.0;
+
+/// A resolved trial condition: the design at 1× and what the trial changes.
+#[derive(Clone, Debug)]
+pub struct Condition {
+    pub design: Design,
+    pub leg_length_m: f64,
+    pub mass_law: MassLaw,
+    pub contact: ContactScaling,
+    pub mass_kg: Option<f64>,
+    pub frequency_hz: Option<f64>,
+    pub amplitude_deg: Option<f64>,
+    /// Servo torque limit or bang-bang torque magnitude.
+    pub torque_nm: Option<f64>,
+    pub slope_deg: Option<f64>,
+}
+
+/// Simulated metrics of one condition, by [`Metric::index`] (NaN: not computed, or the
+/// walk fell).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SimMetrics {
+    pub values: [f64; 8],
+    pub fell: bool,
+}
+
+impl SimMetrics {
+    pub fn get(&self, m: Metric) -> f64 {
+        self.values[m.index()]
+    }
+}
+
+/// Resolves the trials' designs (bundled name, or a TOML path relative to the trials file)
+/// and condition columns.
+pub fn resolve(set: &TrialSet) -> Result<Vec<Condition>, GapError> {
+    set.trials
+        .iter()
+        .map(|t| resolve_trial(t, &set.origin, &set.base_dir))
+        .collect()
+}
+
+fn resolve_trial(t: &Trial, origin: &str, base: &Path) -> Result<Condition, GapError> {
+    let at = |message: String| GapError::Trials {
+        path: origin.to_string(),
+        line: t.line,
+        column: 0,
+        message,
+    };
+    let design = match Design::builtin(&t.design) {
+        Ok(d) => d,
+        Err(crate::sim::SimError::UnknownDesign(_)) => {
+            let p = base.join(&t.design);
+            if !p.exists() {
+                return Err(at(format!(
+                    "design {:?} is neither a bundled design (mugatu, zippy, zippy-spherical, \
+                     mugatu-ref, zippy-ref, zippy-spherical-ref) nor a file {}",
+                    t.design,
+                    p.display()
+                )));
+            }
+            Design::from_file(&p).map_err(|e| at(e.to_string()))?
+        }
+        Err(e) => return Err(at(e.to_string())),
+    };
+    let is_servo = matches!(design.control, ControlSpec::ServoSine { .. });
+    if t.amplitude_deg.is_some() && !is_servo {
+        return Err(at(format!(
+            "amplitude_deg given, but design {} is driven by bang-bang torque (no amplitude)",
+            t.design
+        )));
+    }
+    if t.torque_limit_nm.is_some() && !is_servo {
+        return Err(at(format!(
+            "torque_limit_nm given, but design {} is bang-bang: use torque_nm",
+            t.design
+        )));
+    }
+    if t.torque_nm.is_some() && is_servo {
+        return Err(at(format!(
+            "torque_nm given, but design {} is a position servo: use torque_limit_nm",
+            t.design
+        )));
+    }
+    Ok(Condition {
+        design,
+        leg_length_m: t.leg_length_m,
+        mass_law: t.mass_law.unwrap_or_default(),
+        contact: t.contact.unwrap_or_default(),
+        mass_kg: t.mass_kg,
+        frequency_hz: t.frequency_hz,
+        amplitude_deg: t.amplitude_deg,
+        torque_nm: t.torque_limit_nm.or(t.torque_nm),
+        slope_deg: t.slope_deg,
+    })
+}
+
+impl Condition {
+    /// The design scaled to the condition, with `effect` added (at the design's 1×, scaled
+    /// with it by the effect's rule).
+    pub fn design_with(
+        &self,
+        lib: &EffectLibrary,
+        effect: Option<&EffectSetting>,
+    ) -> Result<Design, GapError> {
+        let mut d = self.design.clone();
+        if let Some(e) = effect {
+            let def = lib.get(&e.effect)?;
+            d.effects.push(def.spec(&self.design, &e.nondimensional)?);
+        }
+        if let (Some(a), ControlSpec::ServoSine { amplitude_deg, .. }) =
+            (self.amplitude_deg, &mut d.control)
+        {
+            *amplitude_deg = a;
+        }
+        if let Some(s) = self.slope_deg {
+            d.ground.slope_deg = s;
+        }
+        let mut d = d
+            .scaled(self.leg_length_m, self.mass_law, self.contact)
+            .map_err(|e| GapError::Sim {
+                origin: self.design.name.clone(),
+                source: e,
+            })?;
+        if let Some(m) = self.mass_kg {
+            d.mass.total_mass_kg = m;
+        }
+        match &mut d.control {
+            ControlSpec::ServoSine {
+                frequency_hz,
+                torque_limit_nm,
+                ..
+            } => {
+                if let Some(f) = self.frequency_hz {
+                    *frequency_hz = f;
+                }
+                if let Some(t) = self.torque_nm {
+                    *torque_limit_nm = t;
+                }
+            }
+            ControlSpec::BangBang {
+                frequency_hz,
+                torque_nm,
+            } => {
+                if let Some(f) = self.frequency_hz {
+                    *frequency_hz = f;
+                }
+                if let Some(t) = self.torque_nm {
+                    *torque_nm = t;
+                }
+            }
+        }
+        Ok(d)
+    }
+
+    /// Simulates the condition with `effect` and measures the metrics.
+    pub fn simulate(
+        &self,
+        lib: &EffectLibrary,
+        effect: Option<&EffectSetting>,
+    ) -> Result<SimMetrics, GapError> {
+        let d = self.design_with(lib, effect)?;
+        let f = match d.control {
+            ControlSpec::ServoSine { frequency_hz, .. } => frequency_hz,
+            ControlSpec::BangBang { frequency_hz, .. } => frequency_hz,
+        };
+        let opts = WalkOptions {
+            duration_s: CYCLES_PER_TRIAL / f,
+            record_trajectory: false,
+            ..WalkOptions::default()
+        };
+        let r = simulate_walk(&d, &opts).map_err(|e| GapError::Sim {
+            origin: format!("{} at L = {} m", self.design.name, self.leg_length_m),
+            source: e,
+        })?;
+        let fell = r.report.fall_reason.is_some();
+        let mut values = [f64::NAN; 8];
+        if !fell {
+            for m in Metric::SIMULATED {
+                values[m.index()] = m.of_report(&r.report);
+            }
+        }
+        Ok(SimMetrics { values, fell })
+    }
+}
+
+/// Simulates every condition with `effect`, in parallel (deterministic: each walk is), and
+/// calls `progress` once per finished walk.
+pub fn simulate_all(
+    conditions: &[Condition],
+    lib: &EffectLibrary,
+    effect: Option<&EffectSetting>,
+    progress: &(dyn Fn() + Sync),
+) -> Result<Vec<SimMetrics>, GapError> {
+    conditions
+        .par_iter()
+        .map(|c| {
+            let r = c.simulate(lib, effect);
+            progress();
+            r
+        })
+        .collect()
+}
+
+/// Simulates many (condition, effect) jobs in parallel, in order.
+pub fn simulate_jobs(
+    jobs: &[(usize, Option<EffectSetting>)],
+    conditions: &[Condition],
+    lib: &EffectLibrary,
+    progress: &(dyn Fn() + Sync),
+) -> Result<Vec<SimMetrics>, GapError> {
+    jobs.par_iter()
+        .map(|(i, e)| {
+            let r = conditions[*i].simulate(lib, e.as_ref());
+            progress();
+            r
+        })
+        .collect()
+}

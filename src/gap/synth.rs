@@ -1,0 +1,205 @@
+//! Synthetic "real" trials: the simulator with effects the nominal model lacks, plus
+//! Gaussian measurement noise, over a default set of conditions or given ones.
+
+use rand::{Rng, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+
+use super::error::GapError;
+use super::library::{EffectLibrary, EffectSetting};
+use super::simulate::{Condition, SimMetrics, resolve};
+use super::trials::{Measurement, Metric, Trial, TrialSet};
+use crate::sim::design::ControlSpec;
+use crate::sim::{Design, WalkOptions, simulate_walk};
+
+/// Drive frequencies tried around the design's, as factors; the default conditions keep
+/// those at which the nominal design walks at 1× (a lab tests conditions where its robot
+/// walks).
+pub const FREQUENCY_FACTORS: [f64; 5] = [0.97, 1.0, 1.03, 0.94, 1.06];
+/// Sizes, as factors of the design's leg length, taken in this order until there are at
+/// least [`MIN_CONDITIONS`] conditions.
+pub const SIZE_FACTORS: [f64; 6] = [1.0, 0.5, 2.0, 0.7, 1.4, 4.0];
+pub const MIN_CONDITIONS: usize = 12;
+
+/// The default conditions for `design_name`: sizes × drive frequencies at which the nominal
+/// design walks (m ∝ L², similar contact).
+pub fn default_conditions(design_name: &str) -> Result<Vec<Trial>, GapError> {
+    let design = Design::resolve(design_name).map_err(|e| GapError::Sim {
+        origin: design_name.to_string(),
+        source: e,
+    })?;
+    let f0 = match design.control {
+        ControlSpec::ServoSine { frequency_hz, .. } => frequency_hz,
+        ControlSpec::BangBang { frequency_hz, .. } => frequency_hz,
+    };
+    let walks: Vec<bool> = {
+        use rayon::prelude::*;
+        FREQUENCY_FACTORS
+            .par_iter()
+            .map(|k| {
+                let o = WalkOptions {
+                    frequency_hz: Some(f0 * k),
+                    duration_s: super::simulate::CYCLES_PER_TRIAL / (f0 * k),
+                    record_trajectory: false,
+                    ..WalkOptions::default()
+                };
+                simulate_walk(&design, &o).map(|r| r.report.walks)
+            })
+            .collect::<Result<Vec<bool>, _>>()
+            .map_err(|e| GapError::Sim {
+                origin: design_name.to_string(),
+                source: e,
+            })?
+    };
+    let mut freqs: Vec<f64> = FREQUENCY_FACTORS
+        .iter()
+        .zip(&walks)
+        .filter(|(_, w)| **w)
+        .map(|(k, _)| *k)
+        .take(4)
+        .collect();
+    if freqs.is_empty() {
+        // The design does not walk near its own frequency: keep the design's own frequency
+        // so the trials still say so.
+        freqs.push(1.0);
+    }
+    freqs.sort_by(f64::total_cmp);
+    let n_sizes = MIN_CONDITIONS.div_ceil(freqs.len()).min(SIZE_FACTORS.len());
+    let mut sizes: Vec<f64> = SIZE_FACTORS[..n_sizes].to_vec();
+    sizes.sort_by(f64::total_cmp);
+    let l0 = design.geometry.leg_length_m;
+    let mut out = Vec::new();
+    for s in &sizes {
+        for k in &freqs {
+            let l = l0 * s;
+            let mut t = Trial::condition(design_name, round_sig(l, 6));
+            t.frequency_hz = Some(round_sig(f0 * k / s.sqrt(), 6));
+            t.label = format!("L{s}x-f{k}x");
+            out.push(t);
+        }
+    }
+    Ok(out)
+}
+
+fn round_sig(x: f64, digits: i32) -> f64 {
+    if x == 0.0 || !x.is_finite() {
+        return x;
+    }
+    let p = 10f64.powi(digits - 1 - x.abs().log10().floor() as i32);
+    (x * p).round() / p
+}
+
+/// A standard normal draw by Box–Muller from ChaCha8 (rand_distr is not a dependency and
+/// one transform does not justify one).
+fn normal(rng: &mut ChaCha8Rng) -> f64 {
+    let u1: f64 = 1.0 - rng.random::<f64>();
+    let u2: f64 = rng.random::<f64>();
+    (-2.0 * u1.ln()).sqrt() * (std::f64::consts::TAU * u2).cos()
+}
+
+/// Measured trials from true metrics: value + FRACTION·|value|·N(0, 1), sd = FRACTION·|value|.
+/// A fallen walk measures nothing. Deterministic in `seed`.
+pub fn add_noise(
+    conditions: &[Trial],
+    truth: &[SimMetrics],
+    noise: f64,
+    seed: u64,
+    source: &str,
+) -> Vec<Trial> {
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    let mut out = Vec::with_capacity(conditions.len());
+    for (t, m) in conditions.iter().zip(truth) {
+        let mut t = t.clone();
+        t.measured = [None; 8];
+        for metric in Metric::SIMULATED {
+            let v = m.get(metric);
+            // Draw even for a missing value, so one trial's fall does not shift the noise of
+            // the others.
+            let e = normal(&mut rng);
+            if !v.is_finite() {
+                continue;
+            }
+            let sd = noise * v.abs();
+            t.measured[metric.index()] = Some(Measurement {
+                value: v + sd * e,
+                sd: (sd > 0.0).then_some(sd),
+            });
+        }
+        t.source = if m.fell {
+            format!("{source}; the walk fell: nothing measured")
+        } else {
+            source.to_string()
+        };
+        out.push(t);
+    }
+    out
+}
+
+/// What `survey gap synth` produces.
+pub struct SynthOptions {
+    pub design: String,
+    pub effects: Vec<EffectSetting>,
+    pub noise: f64,
+    pub seed: u64,
+}
+
+/// Simulates `conditions` (None: the design's defaults) with the withheld effects and
+/// noise; `command` is recorded as every row's source.
+pub fn synthesize(
+    lib: &EffectLibrary,
+    opts: &SynthOptions,
+    conditions: Option<TrialSet>,
+    command: &str,
+    progress: &(dyn Fn() + Sync),
+) -> Result<TrialSet, GapError> {
+    if !(opts.noise >= 0.0 && opts.noise.is_finite() && opts.noise < 1.0) {
+        return Err(GapError::Invalid(format!(
+            "--noise {}: must be a fraction in [0, 1)",
+            opts.noise
+        )));
+    }
+    let set = match conditions {
+        Some(s) => s,
+        None => TrialSet {
+            origin: format!("default conditions of {}", opts.design),
+            base_dir: std::path::PathBuf::from("."),
+            trials: default_conditions(&opts.design)?,
+        },
+    };
+    let resolved = resolve(&set)?;
+    let truth = truth_metrics(&resolved, lib, &opts.effects, progress)?;
+    let trials = add_noise(&set.trials, &truth, opts.noise, opts.seed, command);
+    Ok(TrialSet {
+        origin: set.origin,
+        base_dir: set.base_dir,
+        trials,
+    })
+}
+
+/// The true metrics of the conditions with all `effects` added.
+pub fn truth_metrics(
+    conditions: &[Condition],
+    lib: &EffectLibrary,
+    effects: &[EffectSetting],
+    progress: &(dyn Fn() + Sync),
+) -> Result<Vec<SimMetrics>, GapError> {
+    use rayon::prelude::*;
+    conditions
+        .par_iter()
+        .map(|c| {
+            let mut c = c.clone();
+            // All but the last effect go into the design; the last through simulate().
+            let (last, rest) = match effects.split_last() {
+                Some((l, r)) => (Some(l), r),
+                None => (None, &[][..]),
+            };
+            for e in rest {
+                let def = lib.get(&e.effect)?;
+                let spec = def.spec(&c.design, &e.nondimensional)?;
+                c.design.effects.push(spec);
+            }
+            let r = c.simulate(lib, last);
+            progress();
+            r
+        })
+        .collect()
+}
