@@ -448,6 +448,39 @@ fn build_profile(
     Profile { u, chi2 }
 }
 
+/// Trials whose `trajectory` file is given get the metrics they lack measured from it, by
+/// the code that measures the simulator's walks (`sim::report_from_trajectory`).
+fn fill_from_trajectories(
+    set: &TrialSet,
+    conditions: &[Condition],
+    lib: &EffectLibrary,
+) -> Result<TrialSet, GapError> {
+    let mut out = set.clone();
+    for (t, c) in out.trials.iter_mut().zip(conditions) {
+        let Some(rel) = &t.trajectory else { continue };
+        let path = set.base_dir.join(rel);
+        let at = |message: String| GapError::Trials {
+            path: set.origin.clone(),
+            line: t.line,
+            column: 0,
+            message,
+        };
+        let samples = crate::sim::read_trajectory_csv(&path)
+            .map_err(|e| at(format!("trajectory {}: {e}", path.display())))?;
+        let d = c.design_with(lib, None)?;
+        let report =
+            crate::sim::report_from_trajectory(&d, &crate::sim::WalkOptions::default(), &samples)
+                .map_err(|e| at(format!("trajectory {}: {e}", path.display())))?;
+        for m in Metric::SIMULATED {
+            let v = m.of_report(&report);
+            if t.measured(m).is_none() && v.is_finite() {
+                t.measured[m.index()] = Some(super::trials::Measurement { value: v, sd: None });
+            }
+        }
+    }
+    Ok(out)
+}
+
 /// Observations of the trials: every measured metric a walk simulates.
 pub fn observations(set: &TrialSet, default_relative_sd: f64) -> (Vec<Observation>, Vec<String>) {
     let mut obs = Vec::new();
@@ -543,6 +576,8 @@ pub fn diagnose_conditions(
         return Err(GapError::Invalid("grid points must be in [2, 64]".into()));
     }
     let candidates = lib.subset(&opts.effects)?;
+    let filled = fill_from_trajectories(set, conditions, lib)?;
+    let set = &filled;
     let (obs, mut notes) = observations(set, opts.default_relative_sd);
     if obs.is_empty() {
         return Err(GapError::File {

@@ -335,3 +335,46 @@ fn synth_is_deterministic_and_its_noise_is_stated() {
         assert!(t.source.contains("--effect hip_viscous_damping=0.01"));
     }
 }
+
+#[test]
+fn a_trajectory_file_is_measured_like_a_walk() {
+    // A "measurement" that is the nominal model's own trajectory (sim walk --trajectory):
+    // its metrics, measured by the walk code, must match the nominal simulation.
+    let dir = tempfile::tempdir().expect("tempdir");
+    let traj = dir.path().join("walk.csv");
+    let o = survey(&[
+        "sim",
+        "walk",
+        "--design",
+        "mugatu",
+        "--duration",
+        "13",
+        "--trajectory",
+        traj.to_str().expect("utf-8"),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let text = "label,design,leg_length_m,trajectory,source\nmocap,mugatu,0.153,walk.csv,x\n";
+    let set = TrialSet::parse(text, "t.csv", dir.path()).expect("parses");
+    let lib = EffectLibrary::bundled().expect("library");
+    let conditions = resolve(&set).expect("resolve");
+    let opts = DiagnoseOptions {
+        effects: vec!["hip_viscous_damping".into()],
+        grid_points: 2,
+        ..DiagnoseOptions::default()
+    };
+    let (d, _) = diagnose_conditions(
+        &set,
+        &conditions,
+        &lib,
+        &opts,
+        &SimCache::default(),
+        &|_| {},
+    )
+    .expect("diagnosis");
+    assert_eq!(
+        d.n_observations, 7,
+        "every walk metric measured from the file"
+    );
+    assert!(d.gap_before < 0.3, "gap {}", d.gap_before);
+    assert!(d.best.is_none());
+}
