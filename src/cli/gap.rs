@@ -112,6 +112,9 @@ pub struct BenchmarkArgs {
     /// Noise seeds per (effect, magnitude, noise level).
     #[arg(long, default_value_t = 3)]
     pub seeds: u64,
+    /// Null cases (no effect) per noise level: the false-alarm rate.
+    #[arg(long, default_value_t = 10)]
+    pub null_seeds: u64,
     /// Noise levels (relative sd).
     #[arg(long, value_delimiter = ',', default_values_t = vec![0.01, 0.05, 0.10])]
     pub noise: Vec<f64>,
@@ -246,6 +249,7 @@ fn benchmark(a: &BenchmarkArgs) -> anyhow::Result<ExitCode> {
         noise_levels: a.noise.clone(),
         multiples: a.multiples.clone(),
         effects: a.effects.clone(),
+        null_seeds: a.null_seeds,
     };
     let pb = indicatif::ProgressBar::new_spinner();
     let result = gap::benchmark::run(&lib, &opts, &|what| {

@@ -21,6 +21,8 @@ pub struct BenchmarkOptions {
     /// Magnitudes as multiples of the identification threshold at 5 % noise.
     pub multiples: Vec<f64>,
     pub effects: Vec<String>,
+    /// Null cases (no effect) per noise level.
+    pub null_seeds: u64,
 }
 
 /// Thresholds of one effect at one noise level.
@@ -79,6 +81,7 @@ pub struct BenchmarkResult {
     pub design: String,
     pub conditions: usize,
     pub seeds: u64,
+    pub null_seeds: u64,
     pub multiples: Vec<f64>,
     pub thresholds: Vec<ThresholdRow>,
     pub confusion: Vec<Confusion>,
@@ -228,7 +231,12 @@ pub fn run(
     let mut n_diag = 0usize;
     for &noise in &opts.noise_levels {
         for ((def, k, setting), truth) in truths.iter().zip(&truth_metrics) {
-            for seed in 0..opts.seeds {
+            let seeds = if def.is_none() {
+                opts.null_seeds
+            } else {
+                opts.seeds
+            };
+            for seed in 0..seeds {
                 progress(&format!(
                     "{} × {} at {} % noise, seed {seed}",
                     def.map(|d| d.name.as_str()).unwrap_or("null"),
@@ -369,6 +377,7 @@ pub fn run(
         design: opts.design.clone(),
         conditions: conditions.len(),
         seeds: opts.seeds,
+        null_seeds: opts.null_seeds,
         multiples: opts.multiples.clone(),
         thresholds,
         confusion,

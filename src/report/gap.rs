@@ -337,8 +337,8 @@ pub fn benchmark_md(b: &BenchmarkResult) -> String {
     let mut o = String::new();
     let _ = writeln!(
         o,
-        "# Gap-diagnosis benchmark ({}, {} conditions, {} seeds)\n",
-        b.design, b.conditions, b.seeds
+        "# Gap-diagnosis benchmark ({}, {} conditions, {} seeds per case, {} null cases per noise level)\n",
+        b.design, b.conditions, b.seeds, b.null_seeds
     );
     let _ = writeln!(
         o,
