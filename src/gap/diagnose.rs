@@ -751,7 +751,18 @@ pub fn diagnose_conditions(
     }
     ranking.sort_by(|a, b| a.score.total_cmp(&b.score));
 
-    let best_idx = ranking.iter().position(|r| r.significant);
+    // A call must also be material: the corrected model fits within noise, or the gap at
+    // least halves. A significant but small improvement (a real gap that stays real) is
+    // reported in the ranking and the verdict, not called.
+    let material = |r: &RankedEffect| {
+        let chi_in = r.gap_after_in_sample.powi(2) * n;
+        chi2_sf(chi_in, (n - 1.0).max(1.0)) >= opts.alpha || r.shrink_pct >= 50.0
+    };
+    let best_idx = ranking.iter().position(|r| r.significant && material(r));
+    let partial = ranking
+        .iter()
+        .find(|r| r.significant && !material(r))
+        .map(|r| (r.effect.clone(), r.shrink_pct, r.gap_after));
     let mut best = None;
     let mut after: Option<(usize, f64)> = None;
     if let Some(bi) = best_idx {
@@ -842,7 +853,16 @@ pub fn diagnose_conditions(
             )
         })
         .collect();
-    let verdict = verdict(within_noise, &best, &ranking, gap_before, lr_critical_p);
+    let mut verdict = verdict(within_noise, &best, &ranking, gap_before, lr_critical_p);
+    if best.is_none()
+        && let Some((e, shrink, after)) = partial
+    {
+        verdict = format!(
+            "the gap (RMS z = {gap_before:.2}) is real and no candidate explains it: the best, \
+             {e}, lowers it significantly but only by {shrink:.0} % (held-out RMS z {after:.2}, \
+             still beyond noise) — a model error or an effect outside the library carries the rest"
+        );
+    }
     if obs.iter().any(|o| o.sd_assumed) {
         notes.push(format!(
             "{} of {} measurements state no sd: {} % of the value assumed",
@@ -995,8 +1015,9 @@ fn metric_gaps(res: &[Residual], alpha: f64) -> Vec<MetricGap> {
             format!("over L = {}–{} m", sig3(lmin), sig3(lmax))
         };
         let hot: Vec<&RegimeGap> = regimes.iter().filter(|g| g.significant).collect();
-        let same_sign = hot.iter().all(|g| g.mean_relative_pct < 0.0)
-            || hot.iter().all(|g| g.mean_relative_pct >= 0.0);
+        let same_sign = (hot.iter().all(|g| g.mean_relative_pct < 0.0)
+            || hot.iter().all(|g| g.mean_relative_pct >= 0.0))
+            && regimes.iter().all(|g| g.design == regimes[0].design);
         let statement = if significant
             && regimes.len() > 1
             && !hot.is_empty()
