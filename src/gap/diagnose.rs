@@ -27,7 +27,7 @@ use serde::Serialize;
 use statrs::distribution::{ChiSquared, ContinuousCDF, Normal};
 
 use super::error::GapError;
-use super::library::{EffectDef, EffectLibrary, EffectSetting, OffValue};
+use super::library::{EffectDef, EffectLibrary, EffectSetting};
 use super::simulate::{Condition, SimMetrics, resolve};
 use super::trials::{Metric, TrialSet};
 use crate::regression::{Method, fit_line};
@@ -666,7 +666,7 @@ pub fn diagnose_conditions(
         let rounds = if rank == 0 { 5 } else { 3 };
         for _round in 0..rounds {
             let prof = &profiles[ci];
-            let (j, chi_min) = prof.best();
+            let (j, _) = prof.best();
             if j == prof.off() {
                 break;
             }
@@ -676,7 +676,6 @@ pub fn diagnose_conditions(
             if nodes.iter().any(|x| (x - u_hat).abs() <= tol) && refined[ci] {
                 break;
             }
-            let _ = chi_min;
             let k = nodes.partition_point(|x| *x < u_hat);
             let mut pts = vec![u_hat];
             if k > 0 {
@@ -1273,7 +1272,6 @@ fn identifiability(
         .filter(|m| total > 0.0 && shares[m.index()] >= 0.1 * total)
         .copied()
         .collect();
-    let _ = OffValue::Value(0.0);
     Identifiability {
         effect: def.name.clone(),
         parameter: def.magnitude().name.clone(),

@@ -197,24 +197,6 @@ impl Condition {
     }
 }
 
-/// Simulates every condition with `effect`, in parallel (deterministic: each walk is), and
-/// calls `progress` once per finished walk.
-pub fn simulate_all(
-    conditions: &[Condition],
-    lib: &EffectLibrary,
-    effect: Option<&EffectSetting>,
-    progress: &(dyn Fn() + Sync),
-) -> Result<Vec<SimMetrics>, GapError> {
-    conditions
-        .par_iter()
-        .map(|c| {
-            let r = c.simulate(lib, effect);
-            progress();
-            r
-        })
-        .collect()
-}
-
 /// Simulates many (condition, effect) jobs in parallel, in order.
 pub fn simulate_jobs(
     jobs: &[(usize, Option<EffectSetting>)],
