@@ -31,7 +31,6 @@ use super::library::{EffectDef, EffectLibrary, EffectSetting};
 use super::simulate::{Condition, SimMetrics, resolve};
 use super::trials::{Metric, TrialSet};
 use crate::regression::{Method, fit_line};
-use crate::sim::design::ControlSpec;
 
 /// z² charged to an observation whose simulated walk fell (a 10-sd miss).
 pub const FELL_Z2: f64 = 100.0;
@@ -362,22 +361,40 @@ fn pchip(x: &[f64], y: &[f64], t: f64) -> f64 {
 /// A candidate's walks: the metrics at each simulated magnitude (u = ln magnitude), sorted.
 struct Curve {
     u: Vec<f64>,
-    /// [node][condition]
-    sims: Vec<Vec<SimMetrics>>,
+    /// The walks' metric values, [condition][metric index][node], kept beside `u` so that
+    /// evaluating the interpolant (millions of times in profiles and thresholds) allocates
+    /// nothing.
+    series: Vec<Vec<Vec<f64>>>,
 }
 
 impl Curve {
+    /// `sims` is [node][condition].
+    fn new(u: Vec<f64>, sims: Vec<Vec<SimMetrics>>) -> Curve {
+        let n_cond = sims.first().map(Vec::len).unwrap_or(0);
+        let series = (0..n_cond)
+            .map(|c| {
+                Metric::ALL
+                    .iter()
+                    .map(|m| sims.iter().map(|s| s[c].get(*m)).collect())
+                    .collect()
+            })
+            .collect();
+        Curve { u, series }
+    }
     fn insert(&mut self, u: f64, sims: Vec<SimMetrics>) {
         if self.u.iter().any(|x| (x - u).abs() < 1e-12) {
             return;
         }
         let k = self.u.partition_point(|x| *x < u);
         self.u.insert(k, u);
-        self.sims.insert(k, sims);
+        for (per_metric, s) in self.series.iter_mut().zip(&sims) {
+            for m in Metric::ALL {
+                per_metric[m.index()].insert(k, s.get(m));
+            }
+        }
     }
     fn value(&self, cond: usize, metric: Metric, u: f64) -> f64 {
-        let y: Vec<f64> = self.sims.iter().map(|s| s[cond].get(metric)).collect();
-        pchip(&self.u, &y, u)
+        pchip(&self.u, &self.series[cond][metric.index()], u)
     }
 }
 
@@ -624,7 +641,7 @@ pub fn diagnose_conditions(
     for (lo, hi, off) in &domains {
         let u = grid(*lo, *hi, opts.grid_points);
         let sims: Vec<Vec<SimMetrics>> = (0..u.len()).filter_map(|_| it.next()).collect();
-        let mut curve = Curve { u, sims };
+        let mut curve = Curve::new(u, sims);
         // An off value inside the range (the design's own μ) is a walk already made: the
         // nominal one, a node of the curve.
         if *off > 0.0 && off.is_finite() && (*lo..=*hi).contains(&off.ln()) {
@@ -821,7 +838,7 @@ pub fn diagnose_conditions(
             },
             design: t.design.clone(),
             leg_length_m: c.leg_length_m,
-            frequency_hz: effective_frequency(c),
+            frequency_hz: c.drive_frequency_hz()?,
             metric: o.metric,
             measured: o.value,
             sd: o.sd,
@@ -894,17 +911,6 @@ pub fn diagnose_conditions(
         },
         timing,
     ))
-}
-
-fn effective_frequency(c: &Condition) -> f64 {
-    if let Some(f) = c.frequency_hz {
-        return f;
-    }
-    let f0 = match c.design.control {
-        ControlSpec::ServoSine { frequency_hz, .. } => frequency_hz,
-        ControlSpec::BangBang { frequency_hz, .. } => frequency_hz,
-    };
-    f0 / (c.leg_length_m / c.design.geometry.leg_length_m).sqrt()
 }
 
 /// The 95 % profile interval [u_lo, u_hi] around grid point `j`: Δχ² ≤ χ²₁(0.95)·s²,

@@ -166,6 +166,21 @@ impl Condition {
         Ok(d)
     }
 
+    /// The drive frequency the condition runs at: its own, or the design's scaled to its size.
+    pub fn drive_frequency_hz(&self) -> Result<f64, GapError> {
+        if let Some(f) = self.frequency_hz {
+            return Ok(f);
+        }
+        let d = self
+            .design
+            .scaled(self.leg_length_m, self.mass_law, self.contact)
+            .map_err(|e| GapError::Sim {
+                origin: self.design.name.clone(),
+                source: e,
+            })?;
+        Ok(d.controller().frequency_hz().unwrap_or(f64::NAN))
+    }
+
     /// Simulates the condition with `effect` and measures the metrics.
     pub fn simulate(
         &self,
@@ -173,10 +188,7 @@ impl Condition {
         effect: Option<&EffectSetting>,
     ) -> Result<SimMetrics, GapError> {
         let d = self.design_with(lib, effect)?;
-        let f = match d.control {
-            ControlSpec::ServoSine { frequency_hz, .. } => frequency_hz,
-            ControlSpec::BangBang { frequency_hz, .. } => frequency_hz,
-        };
+        let f = d.controller().frequency_hz().unwrap_or(1.0);
         let opts = WalkOptions {
             duration_s: CYCLES_PER_TRIAL / f,
             record_trajectory: false,

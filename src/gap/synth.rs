@@ -8,7 +8,6 @@ use super::error::GapError;
 use super::library::{EffectLibrary, EffectSetting};
 use super::simulate::{Condition, SimMetrics, resolve};
 use super::trials::{Measurement, Metric, Trial, TrialSet};
-use crate::sim::design::ControlSpec;
 use crate::sim::{Design, WalkOptions, simulate_walk};
 
 /// Drive frequencies tried around the design's, as factors; the default conditions keep
@@ -27,10 +26,7 @@ pub fn default_conditions(design_name: &str) -> Result<Vec<Trial>, GapError> {
         origin: design_name.to_string(),
         source: e,
     })?;
-    let f0 = match design.control {
-        ControlSpec::ServoSine { frequency_hz, .. } => frequency_hz,
-        ControlSpec::BangBang { frequency_hz, .. } => frequency_hz,
-    };
+    let f0 = design.controller().frequency_hz().unwrap_or(1.0);
     let walks: Vec<bool> = {
         use rayon::prelude::*;
         FREQUENCY_FACTORS
