@@ -21,7 +21,7 @@ pub mod laws;
 pub mod predict;
 pub mod regression;
 pub mod report;
-pub mod scaling;
+pub use study::scaling;
 pub mod sim;
 pub mod study;
 pub mod survey;

@@ -6,6 +6,7 @@ mod diff_cmd;
 mod fit_cmd;
 mod gap;
 mod sim;
+mod study;
 
 use std::path::PathBuf;
 use std::process::ExitCode;

@@ -33,6 +33,12 @@ pub enum SimCommand {
     /// The minimum hip torque (servo torque limit, or bang-bang torque magnitude) at which
     /// the design walks consistently at a size, by bracketing and bisection.
     MinTorque(MinTorqueArgs),
+    /// The paper's Table III: minimum hip torque and gait of each design over leg lengths
+    /// 0.02–1.2 m under m ∝ L² and m ∝ L³, with fitted power laws (v ∝ L^a, τ_min ∝ L^b,
+    /// τ_min ∝ (m·L)^c); parallel, resumable (--points) and shardable (--shard i/n).
+    Table3(super::study::Table3Args),
+    /// Join the points files of sharded runs into the file one run writes.
+    Merge(super::study::MergeArgs),
     /// The Drake cross-check: run every elementary case of the goldens' cases.toml in this
     /// engine and compare with Drake's and the analytic values; compare every Drake walk
     /// golden with this engine's walk of the same design (both measured by this code).
@@ -206,6 +212,8 @@ pub fn run(a: &SimArgs) -> anyhow::Result<ExitCode> {
         SimCommand::Analyze(a) => analyze(a),
         SimCommand::Crosscheck(c) => crosscheck(c),
         SimCommand::MinTorque(m) => min_torque(m),
+        SimCommand::Table3(t) => super::study::table3(t),
+        SimCommand::Merge(m) => super::study::merge(m),
     }
 }
 
@@ -221,6 +229,7 @@ fn min_torque(a: &MinTorqueArgs) -> anyhow::Result<ExitCode> {
         rel_tol: a.tolerance,
         cap_over_mgl: a.cap,
         start_nm: None,
+        start_bracket_nm: None,
     };
     let result = robot_survey::study::min_torque(&design, &opts)?;
     print(&match a.run.format {

@@ -45,6 +45,8 @@ pub struct Series {
     pub color: RGBColor,
     pub points: Vec<(f64, f64)>,
     pub line: Option<(f64, f64)>,
+    /// x range of `line` when it is a reference drawn without points (None: the points').
+    pub line_range: Option<(f64, f64)>,
     /// (x, low, high) of a band to shade (e.g. a prediction interval).
     pub band: Vec<(f64, f64, f64)>,
 }
@@ -124,12 +126,18 @@ fn draw_panel<DB: DrawingBackend>(
             .iter()
             .map(|p| p.0)
             .chain(s.band.iter().map(|b| b.0))
+            .chain(s.line_range.iter().flat_map(|r| [r.0, r.1]))
     }));
     let yr = bounds(panel.series.iter().flat_map(|s| {
+        let reference_ends = match (s.line, s.line_range) {
+            (Some((a, b)), Some((lo, hi))) => vec![a * lo.powf(b), a * hi.powf(b)],
+            _ => Vec::new(),
+        };
         s.points
             .iter()
             .map(|p| p.1)
             .chain(s.band.iter().flat_map(|b| [b.1, b.2]))
+            .chain(reference_ends)
     }));
     let mut chart = ChartBuilder::on(area)
         .caption(&panel.title, ("sans-serif", 20))
@@ -174,33 +182,41 @@ fn draw_panel<DB: DrawingBackend>(
                 )))
                 .map_err(|e| e.to_string())?;
         }
-        let anno = chart
-            .draw_series(
+        if !s.points.is_empty() {
+            let anno = chart
+                .draw_series(
+                    s.points
+                        .iter()
+                        .map(|&(x, y)| Circle::new((x, y), 4, color.filled())),
+                )
+                .map_err(|e| e.to_string())?;
+            anno.label(&s.label)
+                .legend(move |(x, y)| Circle::new((x + 8, y), 4, color.filled()));
+        }
+        if let Some((a, b)) = s.line {
+            let (lo, hi) = s.line_range.unwrap_or_else(|| {
                 s.points
                     .iter()
-                    .map(|&(x, y)| Circle::new((x, y), 4, color.filled())),
-            )
-            .map_err(|e| e.to_string())?;
-        anno.label(&s.label)
-            .legend(move |(x, y)| Circle::new((x + 8, y), 4, color.filled()));
-        if let Some((a, b)) = s.line {
-            let (lo, hi) = s
-                .points
-                .iter()
-                .map(|p| p.0)
-                .chain(s.band.iter().map(|p| p.0))
-                .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), v| {
-                    (l.min(v), h.max(v))
-                });
+                    .map(|p| p.0)
+                    .chain(s.band.iter().map(|p| p.0))
+                    .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), v| {
+                        (l.min(v), h.max(v))
+                    })
+            });
             if lo.is_finite() && hi > lo {
                 let steps = 50;
                 let line = (0..=steps).map(|i| {
                     let x = lo * (hi / lo).powf(i as f64 / steps as f64);
                     (x, a * x.powf(b))
                 });
-                chart
+                let drawn = chart
                     .draw_series(LineSeries::new(line, color.stroke_width(2)))
                     .map_err(|e| e.to_string())?;
+                if s.points.is_empty() {
+                    drawn.label(&s.label).legend(move |(x, y)| {
+                        PathElement::new(vec![(x, y), (x + 16, y)], color.stroke_width(2))
+                    });
+                }
             }
         }
     }
@@ -277,6 +293,7 @@ pub fn survey_panels(table: &SurveyTable, t2: &Table2) -> Vec<Panel> {
                         .map(|p| (p.1, p.2))
                         .collect(),
                     line: fit.map(|f| (f.a, f.b)),
+                    line_range: None,
                     band: Vec::new(),
                 }
             })
@@ -317,6 +334,7 @@ pub fn prediction_panel(
                 .map(|p| (p.1, p.2))
                 .collect(),
             line: Some((law.a, law.b)),
+            line_range: None,
             band,
         });
     }
@@ -333,6 +351,7 @@ pub fn prediction_panel(
             color: BLACK,
             points: vec![(l, q.mean)],
             line: None,
+            line_range: None,
             band: Vec::new(),
         });
     }
@@ -350,6 +369,7 @@ pub fn prediction_panel(
                     (r.leg_length_m * s.scale_factor, mass),
                 ],
                 line: Some((r.mass_kg / r.leg_length_m.powf(exp), exp)),
+                line_range: None,
                 band: Vec::new(),
             });
         }
@@ -384,6 +404,7 @@ pub fn scaling_panels(s: &crate::scaling::ScalingStudy) -> Vec<Panel> {
             color: RGBColor(0x1f, 0x77, 0xb4),
             points: walking.iter().map(|w| (w.leg_length_m, y(w))).collect(),
             line: law.as_ref().map(|l| (l.a, l.b)),
+            line_range: None,
             band: Vec::new(),
         }],
     };

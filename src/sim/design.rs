@@ -53,7 +53,9 @@ pub const BUILTIN_DESIGNS: [(&str, &str, &str); 6] = [
 ];
 
 /// How mass follows leg length when a design is scaled.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, Default, clap::ValueEnum)]
+#[derive(
+    Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize, Default, clap::ValueEnum,
+)]
 #[serde(rename_all = "lowercase")]
 pub enum MassLaw {
     /// m ∝ L² (the survey's lower-biped trend).
@@ -73,7 +75,9 @@ impl MassLaw {
 }
 
 /// Rule for the contact parameters when a design is scaled.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, Default, clap::ValueEnum)]
+#[derive(
+    Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize, Default, clap::ValueEnum,
+)]
 #[serde(rename_all = "kebab-case")]
 pub enum ContactScaling {
     /// Dynamic similarity: the foot's static sinkage stays the same fraction of L and the

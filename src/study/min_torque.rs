@@ -36,6 +36,10 @@ pub struct MinTorqueOptions {
     pub cap_over_mgl: f64,
     /// First torque tried [N·m] (None: the scaled design's own).
     pub start_nm: Option<f64>,
+    /// Warm start: a bracket [failing, walking] expected to hold (e.g. the neighbouring
+    /// size's, rescaled by m·g·L). Its walking end is tried first and its width is the
+    /// first step; the step squares (up to ×2) while the bracket is not confirmed.
+    pub start_bracket_nm: Option<[f64; 2]>,
 }
 
 impl Default for MinTorqueOptions {
@@ -49,6 +53,7 @@ impl Default for MinTorqueOptions {
             rel_tol: 0.02,
             cap_over_mgl: 2.0,
             start_nm: None,
+            start_bracket_nm: None,
         }
     }
 }
@@ -152,10 +157,19 @@ pub fn min_torque(design: &Design, opts: &MinTorqueOptions) -> Result<MinTorqueR
     let m = scaled.mass.total_mass_kg;
     let mgl = m * GRAVITY_MPS2 * l;
     let cap = opts.cap_over_mgl * mgl;
-    let start = opts
-        .start_nm
-        .unwrap_or_else(|| scaled.controller().torque_limit_nm().unwrap_or(mgl))
-        .clamp(1e-6 * mgl, cap);
+    // First torque and first step ratio: the warm bracket's walking end and width, or the
+    // design's own torque and a factor 2.
+    let (start, mut ratio) = match opts.start_bracket_nm {
+        Some([lo, hi]) if lo > 0.0 && hi > lo && hi.is_finite() => {
+            (hi, (hi / lo).max(1.0 + 0.5 * opts.rel_tol))
+        }
+        _ => (
+            opts.start_nm
+                .unwrap_or_else(|| scaled.controller().torque_limit_nm().unwrap_or(mgl)),
+            2.0,
+        ),
+    };
+    let start = start.clamp(1e-6 * mgl, cap);
     let mut problem = WalksAt {
         design,
         walk: &opts.walk,
@@ -186,13 +200,14 @@ pub fn min_torque(design: &Design, opts: &MinTorqueOptions) -> Result<MinTorqueR
         failure_below: None,
         criterion,
     };
-    // Bracket: [lo fails, hi walks].
+    // Bracket: [lo fails, hi walks], stepping by `ratio`, which squares (up to 2) at every
+    // step that does not close the bracket.
     let (mut lo, mut hi, mut gait, mut below) = match problem.evaluate(start)? {
         Ok(g) => {
             let mut hi = start;
             let mut gait = g;
             loop {
-                let t = 0.5 * hi;
+                let t = hi / ratio;
                 if t < 1e-4 * mgl {
                     // Walks with (almost) no torque: a passive gait; report the floor.
                     result.walks = true;
@@ -207,6 +222,7 @@ pub fn min_torque(design: &Design, opts: &MinTorqueOptions) -> Result<MinTorqueR
                     Ok(g) => {
                         hi = t;
                         gait = g;
+                        ratio = (ratio * ratio).min(2.0);
                     }
                     Err(f) => break (t, hi, gait, f),
                 }
@@ -216,17 +232,18 @@ pub fn min_torque(design: &Design, opts: &MinTorqueOptions) -> Result<MinTorqueR
             let mut lo = start;
             let mut fail = f;
             loop {
-                let t = 2.0 * lo;
-                if t > cap {
+                if lo >= cap {
                     result.failure_below = Some(failure(&fail));
                     result.walks_evaluated = problem.evaluated;
                     return Ok(result);
                 }
+                let t = (lo * ratio).min(cap);
                 match problem.evaluate(t)? {
                     Ok(g) => break (lo, t, g, fail),
                     Err(f) => {
                         lo = t;
                         fail = f;
+                        ratio = (ratio * ratio).min(2.0);
                     }
                 }
             }

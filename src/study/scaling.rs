@@ -38,7 +38,7 @@ pub struct ScalingStudy {
     pub torque_vs_mass_length: Option<StudyLaw>,
 }
 
-fn law(x: &'static str, y: &'static str, xs: &[f64], ys: &[f64]) -> Option<StudyLaw> {
+pub(crate) fn law(x: &'static str, y: &'static str, xs: &[f64], ys: &[f64]) -> Option<StudyLaw> {
     if xs.len() < 3 {
         return None;
     }

@@ -19,5 +19,6 @@ mod sim_walk;
 mod survey_html;
 mod survey_inference;
 mod table2;
+mod table3;
 mod upstream_import;
 mod validate_corpus;

@@ -1,0 +1,289 @@
+//! `survey sim table3`, `survey sim merge` (and the foot study): sweeps over the simulator.
+
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+
+use clap::{Args, ValueEnum};
+use robot_survey::report::{self, plot};
+use robot_survey::sim::{ContactScaling, Design, MassLaw};
+use robot_survey::study::paper::PaperTable3;
+use robot_survey::study::sweep::{self, Shard};
+use robot_survey::study::table3::{self, TABLE3_KIND, Table3Point};
+use robot_survey::study::{Table3Spec, run_table3};
+
+use super::print;
+
+/// Which contact rules a study runs.
+#[derive(ValueEnum, Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub enum ContactChoice {
+    /// Both rules, reported side by side.
+    #[default]
+    Both,
+    Similar,
+    FixedMaterial,
+}
+
+impl ContactChoice {
+    fn rules(self) -> Vec<ContactScaling> {
+        match self {
+            ContactChoice::Both => vec![ContactScaling::Similar, ContactScaling::FixedMaterial],
+            ContactChoice::Similar => vec![ContactScaling::Similar],
+            ContactChoice::FixedMaterial => vec![ContactScaling::FixedMaterial],
+        }
+    }
+}
+
+#[derive(ValueEnum, Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub enum TableFormat {
+    #[default]
+    Md,
+    Tex,
+    Csv,
+    Json,
+}
+
+#[derive(Args, Debug)]
+#[command(after_help = "Examples:
+  survey sim table3 --contact similar --format json
+  survey sim table3 --out reports/            # md, tex, csv, json and figures; resumable
+  survey sim table3 --points t3.csv --shard 2/6  # one slice (a Slurm array task)
+  survey sim merge t3-*.csv --out t3.csv && survey sim table3 --points t3.csv
+
+Each design × mass law × contact rule is a chain over the sizes, run smallest first, each size \
+warm-started from its neighbour's torque bracket (rescaled by m·g·L). Chains run in parallel \
+on every core and are the unit of --shard. With --points (default DIR/table3.points.csv under \
+--out) every finished size is appended at once: run the same command again to resume.
+
+Walks consistently = no fall and steady forward speed above the design's threshold from the \
+unperturbed start and --seeds perturbed starts. Velocity and attitudes are of the walk at the \
+design's own torque (scaled ∝ m·g·L) when it walks there, else at the minimum torque.")]
+pub struct Table3Args {
+    /// Designs (built-in names or TOML paths), comma separated.
+    #[arg(
+        long,
+        value_delimiter = ',',
+        default_value = "zippy,zippy-spherical,mugatu"
+    )]
+    pub designs: Vec<String>,
+    /// Mass laws, comma separated.
+    #[arg(long, value_enum, value_delimiter = ',', default_value = "l2,l3")]
+    pub mass_laws: Vec<MassLaw>,
+    /// Contact rule(s): similar scales every contact parameter by dynamic similarity (the
+    /// exponents are then 0.5 and m·L by construction); fixed-material keeps the foot
+    /// material (modulus, dissipation) of the 1× design at every size.
+    #[arg(long, value_enum, default_value_t)]
+    pub contact: ContactChoice,
+    /// Number of log-spaced sizes from 0.02 to 1.2 m (0.025, 0.15 and 1.0 m included).
+    #[arg(long, default_value_t = 36, value_parser = clap::value_parser!(u64).range(4..=1000))]
+    pub sizes: u64,
+    /// Explicit leg lengths [m] instead of --sizes.
+    #[arg(long, value_delimiter = ',', value_name = "M,M,...")]
+    pub leg_lengths: Option<Vec<f64>>,
+    /// Simulated time at the design's own size [s]; ∝ √L at other sizes (the same number
+    /// of drive cycles everywhere).
+    #[arg(long, default_value_t = 25.0)]
+    pub duration: f64,
+    /// Perturbed starts that must walk too (besides the unperturbed one).
+    #[arg(long, default_value_t = 2, value_parser = clap::value_parser!(u64).range(0..=20))]
+    pub seeds: u64,
+    /// Relative tolerance of the minimum torque.
+    #[arg(long, default_value_t = 0.02)]
+    pub tolerance: f64,
+    /// Largest torque tried, in units of m·g·L.
+    #[arg(long, default_value_t = 2.0)]
+    pub cap: f64,
+    /// Points file: finished sizes are appended as they finish and skipped on a re-run.
+    #[arg(long, value_name = "FILE")]
+    pub points: Option<PathBuf>,
+    /// Run only slice i of n (chains k with k mod n = i − 1); needs --points.
+    #[arg(long, value_name = "i/n")]
+    pub shard: Option<Shard>,
+    /// Write table3.{md,tex,csv,json}, table3-velocity.svg and table3-torque.svg here.
+    #[arg(long, value_name = "DIR")]
+    pub out: Option<PathBuf>,
+    #[arg(long, value_enum, default_value_t)]
+    pub format: TableFormat,
+}
+
+#[derive(Args, Debug)]
+#[command(after_help = "Example:
+  survey sim merge shard-1.csv shard-2.csv shard-3.csv --out table3.points.csv
+
+The inputs must come from one specification (their first lines agree); a point present in two \
+files must be identical in both. The merged file is what one unsharded run writes, byte for \
+byte; pass it to the study with --points to get the table without simulating again.")]
+pub struct MergeArgs {
+    /// Points files written by `--shard` runs.
+    #[arg(required = true, value_name = "FILE")]
+    pub inputs: Vec<PathBuf>,
+    /// The merged points file.
+    #[arg(long, value_name = "FILE")]
+    pub out: PathBuf,
+}
+
+struct Bar(indicatif::ProgressBar);
+
+impl table3::Observer for Bar {
+    fn point_done(&self, p: &Table3Point, resumed: bool) {
+        self.0.set_message(format!(
+            "{} {:?} {:?} L = {} m{}",
+            p.design,
+            p.mass_law,
+            p.contact,
+            p.leg_length_m,
+            if resumed {
+                " (from the points file)"
+            } else {
+                ""
+            }
+        ));
+        self.0.inc(1);
+    }
+}
+
+pub fn table3_spec(a: &Table3Args) -> anyhow::Result<Table3Spec> {
+    let designs = a
+        .designs
+        .iter()
+        .map(|d| Design::resolve(d))
+        .collect::<Result<Vec<_>, _>>()?;
+    let mut spec = Table3Spec::paper(designs, a.contact.rules());
+    spec.mass_laws = a.mass_laws.clone();
+    if let Some(ls) = &a.leg_lengths {
+        if let Some(bad) = ls.iter().find(|l| !(l.is_finite() && **l > 0.0)) {
+            anyhow::bail!("--leg-lengths: {bad} is not a positive length in metres");
+        }
+        spec.leg_lengths_m = ls.clone();
+    } else {
+        spec.leg_lengths_m = table3::table3_leg_lengths(a.sizes as usize);
+    }
+    spec.duration_at_design_size_s = a.duration;
+    spec.seeds = a.seeds;
+    spec.rel_tol = a.tolerance;
+    spec.cap_over_mgl = a.cap;
+    Ok(spec)
+}
+
+pub fn table3(a: &Table3Args) -> anyhow::Result<ExitCode> {
+    let spec = table3_spec(a)?;
+    let shard = a.shard.unwrap_or(Shard::WHOLE);
+    let points = a
+        .points
+        .clone()
+        .or_else(|| a.out.as_ref().map(|d| d.join("table3.points.csv")));
+    if shard != Shard::WHOLE && points.is_none() {
+        anyhow::bail!("--shard {shard} writes its points to a file: give --points FILE");
+    }
+    if let Some(dir) = &a.out {
+        std::fs::create_dir_all(dir)
+            .map_err(|e| anyhow::anyhow!("cannot create {}: {e}", dir.display()))?;
+    }
+    let total = spec
+        .chains()
+        .iter()
+        .enumerate()
+        .filter(|(k, _)| shard.takes(*k))
+        .count()
+        * spec.leg_lengths_m.len();
+    let bar = indicatif::ProgressBar::new(total as u64);
+    bar.set_style(
+        indicatif::ProgressStyle::with_template(
+            "table3 [{bar:30}] {pos}/{len} sizes, {elapsed} (eta {eta}) {msg}",
+        )
+        .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
+    );
+    let run = run_table3(&spec, shard, points.as_deref(), &Bar(bar.clone()))?;
+    bar.finish_and_clear();
+    let Some(table) = run.table else {
+        eprintln!(
+            "shard {shard}: {} sizes ({} simulated now) in {}; join the shards with `survey sim merge`",
+            run.points.len(),
+            run.simulated,
+            points
+                .as_deref()
+                .map(|p| p.display().to_string())
+                .unwrap_or_default()
+        );
+        return Ok(ExitCode::SUCCESS);
+    };
+    if let Some(p) = &points {
+        // A complete run leaves its points file in canonical order (what merge writes).
+        let mut all = run.points.clone();
+        all.sort_by_key(sweep::SweepPoint::key);
+        sweep::write_points(p, &spec.header(), &all)?;
+    }
+    let paper = PaperTable3::bundled().ok();
+    let render = |f: TableFormat| -> anyhow::Result<String> {
+        Ok(match f {
+            TableFormat::Md => report::study::table3_md(&table, paper.as_ref()),
+            TableFormat::Tex => report::study::table3_tex(&table),
+            TableFormat::Csv => report::study::table3_csv(&table)?,
+            TableFormat::Json => report::json(&table)?,
+        })
+    };
+    if let Some(dir) = &a.out {
+        for (f, ext) in [
+            (TableFormat::Md, "md"),
+            (TableFormat::Tex, "tex"),
+            (TableFormat::Csv, "csv"),
+            (TableFormat::Json, "json"),
+        ] {
+            write(&dir.join(format!("table3.{ext}")), &render(f)?)?;
+        }
+        let n = report::study::table3_velocity_panels(&table).len().max(1) as u32;
+        for (name, panels) in [
+            (
+                "table3-velocity.svg",
+                report::study::table3_velocity_panels(&table),
+            ),
+            (
+                "table3-torque.svg",
+                report::study::table3_torque_panels(&table),
+            ),
+        ] {
+            let path = dir.join(name);
+            plot::draw_panels(&path, &panels, (560 * n, 520))?;
+            eprintln!("wrote {}", path.display());
+        }
+    }
+    print(&render(a.format)?);
+    Ok(ExitCode::SUCCESS)
+}
+
+fn write(path: &Path, text: &str) -> anyhow::Result<()> {
+    std::fs::write(path, text)
+        .map_err(|e| anyhow::anyhow!("cannot write {}: {e}", path.display()))?;
+    eprintln!("wrote {}", path.display());
+    Ok(())
+}
+
+pub fn merge(a: &MergeArgs) -> anyhow::Result<ExitCode> {
+    let first = a
+        .inputs
+        .first()
+        .ok_or_else(|| anyhow::anyhow!("no points files given"))?;
+    let kind = sweep::points_kind(first)?;
+    let n = match kind.as_str() {
+        TABLE3_KIND => merge_kind::<Table3Point>(&a.inputs, &a.out)?,
+        other => anyhow::bail!(
+            "{}: a points file of study `{other}`, which `survey sim merge` does not know",
+            first.display()
+        ),
+    };
+    eprintln!(
+        "merged {} files: {n} points → {}",
+        a.inputs.len(),
+        a.out.display()
+    );
+    Ok(ExitCode::SUCCESS)
+}
+
+fn merge_kind<R: sweep::SweepPoint + PartialEq>(
+    inputs: &[PathBuf],
+    out: &Path,
+) -> anyhow::Result<usize> {
+    let (header, mut rows) = sweep::merge::<R>(inputs)?;
+    rows.sort_by_key(|p| p.key());
+    sweep::write_points(out, &header, &rows)?;
+    Ok(rows.len())
+}
