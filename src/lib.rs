@@ -9,6 +9,7 @@
 //! - [`gap`]: sim-to-real gap diagnosis (trials, candidate effects, fitting, benchmark).
 //! - [`crosscheck`]: the simulator against Drake on identical models (goldens from tools/drake/).
 //! - [`predict`], [`inference`], [`laws`]: designer predictions, hypothesis tests, Table 1.
+//! - [`motors`]: the motor catalogue (scaling laws, actuator datasheets, anchors) and its validation.
 //! - [`diff`]: the live records against a frozen release, for a pull request's reviewer.
 //! - [`report`]: output formats (md, tex, csv, json) and figures.
 
@@ -18,6 +19,7 @@ pub mod diff;
 pub mod gap;
 pub mod inference;
 pub mod laws;
+pub mod motors;
 pub mod predict;
 pub mod regression;
 pub mod report;

@@ -6,6 +6,7 @@ use std::process::ExitCode;
 use anyhow::{Context, bail};
 use clap::{Args, Subcommand, ValueEnum};
 use robot_survey::dataset::{self, Dataset, upstream};
+use robot_survey::motors::{MotorCatalogue, MotorProblem};
 use robot_survey::report;
 
 use super::{DatasetArgs, EXIT_PROBLEMS, print};
@@ -149,6 +150,26 @@ pub fn validate(a: &ValidateArgs) -> anyhow::Result<ExitCode> {
             )
         });
     }
+    // The motor catalogue (<dataset>/motors/), when the dataset has one; not with --release.
+    let motors: Option<(Vec<dataset::Problem>, String)> = match &a.data.release {
+        Some(_) => None,
+        None => MotorCatalogue::from_dataset_files(&ds.files).map(|read| match read {
+            Ok(cat) => {
+                let problems = cat.validate();
+                let summary = cat.summary_line(&problems);
+                (
+                    problems.iter().map(MotorProblem::to_problem).collect(),
+                    summary,
+                )
+            }
+            Err(e) => (vec![e.to_problem()], "motors: not read: 1 error(s)".into()),
+        }),
+    };
+    let motor_errors = motors
+        .iter()
+        .flat_map(|(p, _)| p)
+        .filter(|p| p.severity == dataset::Severity::Error)
+        .count();
     match a.format {
         TextOrJson::Text => {
             let mut text = report::validation_text(&rep);
@@ -158,11 +179,21 @@ pub fn validate(a: &ValidateArgs) -> anyhow::Result<ExitCode> {
                     &dataset::validate::coverage(&ds),
                 )),
             }
+            if let Some((problems, summary)) = &motors {
+                for p in problems {
+                    text.push_str(&format!("{}\n", p.to_line()));
+                }
+                text.push_str(&format!("{summary}\n"));
+            }
             print(&text)
         }
-        TextOrJson::Json => print(&report::json(&rep.problems)?),
+        TextOrJson::Json => {
+            let mut all = rep.problems.clone();
+            all.extend(motors.iter().flat_map(|(p, _)| p.iter().cloned()));
+            print(&report::json(&all)?)
+        }
     }
-    Ok(if rep.errors() > 0 {
+    Ok(if rep.errors() + motor_errors > 0 {
         ExitCode::from(EXIT_PROBLEMS)
     } else {
         ExitCode::SUCCESS

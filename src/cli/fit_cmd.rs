@@ -170,6 +170,77 @@ pub struct PredictArgs {
     /// Also draw mass vs leg length with each class's prediction band (SVG or PNG by extension).
     #[arg(long, value_name = "FILE")]
     pub plot: Option<PathBuf>,
+    /// With --from design:NAME: the Table III contact rule the required torque comes from.
+    #[arg(long, value_enum, default_value_t = robot_survey::sim::ContactScaling::FixedMaterial)]
+    pub torque_contact: robot_survey::sim::ContactScaling,
+    /// With --from design:NAME: actuators must deliver this multiple of the required torque
+    /// at stall.
+    #[arg(long, default_value_t = 2.0)]
+    pub torque_margin: f64,
+    /// Table III points for the torque (default: the bundled reports/table3.points.csv).
+    #[arg(long, value_name = "FILE")]
+    pub table3: Option<PathBuf>,
+}
+
+/// `survey predict` with the required hip torque of a design.
+#[derive(serde::Serialize)]
+struct PredictionWithTorque<'a> {
+    #[serde(flatten)]
+    prediction: &'a robot_survey::predict::Prediction,
+    torque: &'a robot_survey::study::torque_need::TorqueNeed,
+}
+
+fn torque_need(
+    a: &PredictArgs,
+    design: &str,
+    pred: &robot_survey::predict::Prediction,
+) -> anyhow::Result<Option<robot_survey::study::torque_need::TorqueNeed>> {
+    let Some(l) = a.leg_length else {
+        return Ok(None);
+    };
+    if !(a.torque_margin.is_finite() && a.torque_margin > 0.0) {
+        anyhow::bail!("--torque-margin must be > 0, got {}", a.torque_margin);
+    }
+    let points = super::study::load_table3_points(a.table3.as_deref())?;
+    let motors = super::study::load_motors(None).ok();
+    let mut masses = Vec::new();
+    if let Some(q) = pred
+        .quantities
+        .iter()
+        .find(|q| q.quantity == robot_survey::survey::Var::Mass)
+    {
+        masses.push((
+            format!(
+                "{} fit (mean, {:.0} % prediction interval)",
+                pred.class.as_str(),
+                100.0 * pred.confidence
+            ),
+            q.mean,
+            Some(q.prediction_interval),
+        ));
+    }
+    if let Some(r) = &pred.scaled_reference {
+        masses.push((
+            format!("{} scaled, m ∝ L²", r.reference.name),
+            r.mass_l2_kg,
+            None,
+        ));
+        masses.push((
+            format!("{} scaled, m ∝ L³", r.reference.name),
+            r.mass_l3_kg,
+            None,
+        ));
+    }
+    Ok(Some(robot_survey::study::torque_need::torque_need(
+        &points,
+        design,
+        robot_survey::sim::MassLaw::L2,
+        a.torque_contact,
+        l,
+        &masses,
+        motors.as_ref(),
+        a.torque_margin,
+    )?))
 }
 
 pub fn predict(a: &PredictArgs) -> anyhow::Result<ExitCode> {
@@ -193,15 +264,29 @@ pub fn predict(a: &PredictArgs) -> anyhow::Result<ExitCode> {
         confidence: a.confidence,
     };
     let pred = p::predict(&table, class, &req)?;
+    let torque = match a.from.as_deref().and_then(|r| r.strip_prefix("design:")) {
+        Some(name) => torque_need(a, name, &pred)?,
+        None => None,
+    };
     if let Some(path) = &a.plot {
         let panel = report::plot::prediction_panel(&table, &pred)?;
         report::plot::draw_panels(path, &[panel], (900, 650))?;
         eprintln!("wrote {}", path.display());
     }
-    print(&match a.format {
-        Format::Json => report::json(&pred)?,
-        Format::Md => report::prediction_text(&pred),
-        f => anyhow::bail!("--format {f:?} is not available for predict (use md or json)"),
+    print(&match (a.format, &torque) {
+        (Format::Json, Some(t)) => report::json(&PredictionWithTorque {
+            prediction: &pred,
+            torque: t,
+        })?,
+        (Format::Json, None) => report::json(&pred)?,
+        (Format::Md, t) => {
+            let mut s = report::prediction_text(&pred);
+            if let Some(t) = t {
+                s.push_str(&report::study::torque_need_text(t));
+            }
+            s
+        }
+        (f, _) => anyhow::bail!("--format {f:?} is not available for predict (use md or json)"),
     });
     Ok(ExitCode::SUCCESS)
 }

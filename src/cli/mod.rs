@@ -67,6 +67,10 @@ pub enum Command {
     /// The sim-to-real gap: where the simulation misses measured trials, which unmodelled
     /// effect explains it, how far the gap shrinks (and synthetic trials to prove it).
     Gap(gap::GapArgs),
+    /// Walker hip torque against motor-torque scaling laws: Table III's minimum torque
+    /// across leg length beside what each law delivers, under two explicit bridges between
+    /// motor size and robot size (isometric actuator; fixed actuator mass fraction).
+    TorqueCheck(study::TorqueCheckArgs),
 }
 
 /// Entry point: parse, run, map errors to exit codes.
@@ -100,6 +104,7 @@ fn run(cli: Cli) -> anyhow::Result<ExitCode> {
         Command::Dataset(a) => dataset_cmd::run(&a),
         Command::Sim(a) => sim::run(&a),
         Command::Gap(a) => gap::run(&a),
+        Command::TorqueCheck(a) => study::torque_check(&a),
     }
 }
 

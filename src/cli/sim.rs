@@ -37,6 +37,9 @@ pub enum SimCommand {
     /// 0.02–1.2 m under m ∝ L² and m ∝ L³, with fitted power laws (v ∝ L^a, τ_min ∝ L^b,
     /// τ_min ∝ (m·L)^c); parallel, resumable (--points) and shardable (--shard i/n).
     Table3(super::study::Table3Args),
+    /// The foot study: each foot semi-axis scaled 0.5–2.0× at three sizes; which feet walk,
+    /// feasible semi-axis vs L as power laws, the fastest foot against the Froude prediction.
+    Feet(super::study::FeetArgs),
     /// Join the points files of sharded runs into the file one run writes.
     Merge(super::study::MergeArgs),
     /// The Drake cross-check: run every elementary case of the goldens' cases.toml in this
@@ -214,6 +217,7 @@ pub fn run(a: &SimArgs) -> anyhow::Result<ExitCode> {
         SimCommand::MinTorque(m) => min_torque(m),
         SimCommand::Table3(t) => super::study::table3(t),
         SimCommand::Merge(m) => super::study::merge(m),
+        SimCommand::Feet(f) => super::study::feet(f),
     }
 }
 

@@ -121,6 +121,128 @@ pub struct MergeArgs {
     pub out: PathBuf,
 }
 
+#[derive(Args, Debug)]
+#[command(after_help = "Examples:
+  survey sim feet                                   # Mugatu and Zippy at 0.025, 0.15, 1.0 m
+  survey sim feet --contact similar --out reports/   # feet.{md,json,csv}, feet.svg
+  survey sim feet --points feet.csv --shard 1/4
+
+Each semi-axis of the foot (R_X fore-aft, R_Y lateral, R_Z vertical) is scaled alone by \
+--factors (the others at 1×) and the walker runs once with its own scaled control; a foot \
+walks when it does not fall and its steady speed exceeds the design's threshold.")]
+pub struct FeetArgs {
+    /// Designs (built-in names or TOML paths), comma separated.
+    #[arg(long, value_delimiter = ',', default_value = "mugatu,zippy")]
+    pub designs: Vec<String>,
+    /// Leg lengths [m].
+    #[arg(long, value_delimiter = ',', default_value = "0.025,0.15,1.0")]
+    pub leg_lengths: Vec<f64>,
+    /// Multipliers of one semi-axis (default 0.5 to 2.0 in steps of 0.1).
+    #[arg(long, value_delimiter = ',')]
+    pub factors: Option<Vec<f64>>,
+    #[arg(long, value_enum, default_value_t)]
+    pub contact: ContactChoice,
+    #[arg(long, value_enum, default_value_t)]
+    pub mass_law: MassLaw,
+    /// Simulated time at the design's own size [s]; ∝ √L elsewhere.
+    #[arg(long, default_value_t = 25.0)]
+    pub duration: f64,
+    /// Points file (resumable); default DIR/feet.points.csv under --out.
+    #[arg(long, value_name = "FILE")]
+    pub points: Option<PathBuf>,
+    #[arg(long, value_name = "i/n")]
+    pub shard: Option<Shard>,
+    /// Write feet.{md,json,csv} and feet.svg here.
+    #[arg(long, value_name = "DIR")]
+    pub out: Option<PathBuf>,
+    /// md or json (csv: the points).
+    #[arg(long, value_enum, default_value_t)]
+    pub format: TableFormat,
+}
+
+pub fn feet(a: &FeetArgs) -> anyhow::Result<ExitCode> {
+    use robot_survey::study::feet::{FeetSpec, run_feet};
+    let designs = a
+        .designs
+        .iter()
+        .map(|d| Design::resolve(d))
+        .collect::<Result<Vec<_>, _>>()?;
+    let mut spec = FeetSpec::paper(designs, a.contact.rules());
+    spec.leg_lengths_m = a.leg_lengths.clone();
+    if let Some(f) = &a.factors {
+        spec.factors = f.clone();
+    }
+    spec.mass_law = a.mass_law;
+    spec.duration_at_design_size_s = a.duration;
+    let shard = a.shard.unwrap_or(Shard::WHOLE);
+    let points = a
+        .points
+        .clone()
+        .or_else(|| a.out.as_ref().map(|d| d.join("feet.points.csv")));
+    if shard != Shard::WHOLE && points.is_none() {
+        anyhow::bail!("--shard {shard} writes its points to a file: give --points FILE");
+    }
+    if let Some(dir) = &a.out {
+        std::fs::create_dir_all(dir)
+            .map_err(|e| anyhow::anyhow!("cannot create {}: {e}", dir.display()))?;
+    }
+    let total = spec
+        .units()
+        .iter()
+        .enumerate()
+        .filter(|(k, _)| shard.takes(*k))
+        .count();
+    let bar = indicatif::ProgressBar::new(total as u64);
+    bar.set_style(
+        indicatif::ProgressStyle::with_template(
+            "feet [{bar:30}] {pos}/{len} feet, {elapsed} (eta {eta})",
+        )
+        .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
+    );
+    let run = run_feet(&spec, shard, points.as_deref(), &|_, _| bar.inc(1))?;
+    bar.finish_and_clear();
+    let Some(study) = run.study else {
+        eprintln!(
+            "shard {shard}: {} feet ({} simulated now); join the shards with `survey sim merge`",
+            run.points.len(),
+            run.simulated
+        );
+        return Ok(ExitCode::SUCCESS);
+    };
+    if let Some(p) = &points {
+        sweep::write_points(p, &spec.header(), &study.points)?;
+    }
+    let render = |f: TableFormat| -> anyhow::Result<String> {
+        Ok(match f {
+            TableFormat::Md | TableFormat::Tex => report::study::feet_md(&study),
+            TableFormat::Json => report::json(&study)?,
+            TableFormat::Csv => {
+                let mut w = csv::Writer::from_writer(Vec::new());
+                for p in &study.points {
+                    w.serialize(p)?;
+                }
+                String::from_utf8_lossy(&w.into_inner().map_err(|e| e.into_error())?).into_owned()
+            }
+        })
+    };
+    if let Some(dir) = &a.out {
+        for (f, ext) in [
+            (TableFormat::Md, "md"),
+            (TableFormat::Json, "json"),
+            (TableFormat::Csv, "csv"),
+        ] {
+            write(&dir.join(format!("feet.{ext}")), &render(f)?)?;
+        }
+        let panels = report::study::feet_panels(&study);
+        let n = panels.len().max(1) as u32;
+        let path = dir.join("feet.svg");
+        plot::draw_panels(&path, &panels, (520 * n, 520))?;
+        eprintln!("wrote {}", path.display());
+    }
+    print(&render(a.format)?);
+    Ok(ExitCode::SUCCESS)
+}
+
 struct Bar(indicatif::ProgressBar);
 
 impl table3::Observer for Bar {
@@ -265,6 +387,9 @@ pub fn merge(a: &MergeArgs) -> anyhow::Result<ExitCode> {
     let kind = sweep::points_kind(first)?;
     let n = match kind.as_str() {
         TABLE3_KIND => merge_kind::<Table3Point>(&a.inputs, &a.out)?,
+        robot_survey::study::feet::FEET_KIND => {
+            merge_kind::<robot_survey::study::feet::FootPoint>(&a.inputs, &a.out)?
+        }
         other => anyhow::bail!(
             "{}: a points file of study `{other}`, which `survey sim merge` does not know",
             first.display()
@@ -286,4 +411,106 @@ fn merge_kind<R: sweep::SweepPoint + PartialEq>(
     rows.sort_by_key(|p| p.key());
     sweep::write_points(out, &header, &rows)?;
     Ok(rows.len())
+}
+
+#[derive(Args, Debug)]
+#[command(after_help = "Examples:
+  survey torque-check --design mugatu
+  survey torque-check --design mugatu --mass-law l3 --format json --plot torque-check.svg
+  survey torque-check --design zippy --actuator pololu-micro-metal-lp-6v-297 --voltage 6
+
+The required torque is Table III's minimum torque (the bundled reports/table3.points.csv, or \\
+--points FILE from `survey sim table3`). The motor laws (dataset/motors/laws.toml) have no \\
+published coefficients: each is pinned to the design's own hip actuator at the design's own \\
+size (dataset/motors/anchors.toml), and carried across sizes by two bridges: an isometric \\
+actuator (length ∝ L) or a fixed actuator mass fraction (mass ∝ robot mass).")]
+pub struct TorqueCheckArgs {
+    /// Design (built-in name or TOML path).
+    #[arg(long, default_value = "mugatu")]
+    pub design: String,
+    /// Mass law of the Table III chain.
+    #[arg(long, value_enum, default_value_t)]
+    pub mass_law: MassLaw,
+    /// Contact rule of the Table III chain.
+    #[arg(long, value_enum, default_value_t = ContactScaling::FixedMaterial)]
+    pub contact: ContactScaling,
+    /// Table III points file (default: the bundled reports/table3.points.csv).
+    #[arg(long, value_name = "FILE")]
+    pub points: Option<PathBuf>,
+    /// Pin the laws to this actuator (id in dataset/motors/actuators.toml) instead of the
+    /// design's anchor; it drives the design at its own leg length.
+    #[arg(long, value_name = "ID")]
+    pub actuator: Option<String>,
+    /// Rating voltage of --actuator (default: its recommended voltage).
+    #[arg(long, value_name = "V")]
+    pub voltage: Option<f64>,
+    /// Draw the required torque and every law under both bridges (SVG or PNG).
+    #[arg(long, value_name = "FILE")]
+    pub plot: Option<PathBuf>,
+    /// Motor catalogue folder (default: dataset/motors when present, else the bundled one).
+    #[arg(long, value_name = "DIR")]
+    pub motors: Option<PathBuf>,
+    #[arg(long, value_enum, default_value_t = super::sim::SimFormat::Text)]
+    pub format: super::sim::SimFormat,
+}
+
+/// Table III points: a file, or the bundled copy.
+pub fn load_table3_points(path: Option<&Path>) -> anyhow::Result<Vec<Table3Point>> {
+    Ok(match path {
+        Some(p) => sweep::read_points::<Table3Point>(p)?.1,
+        None => table3::bundled_points()?,
+    })
+}
+
+pub fn load_motors(dir: Option<&Path>) -> anyhow::Result<robot_survey::motors::MotorCatalogue> {
+    use robot_survey::motors::MotorCatalogue;
+    Ok(match dir {
+        Some(d) => MotorCatalogue::load(d)?,
+        None if Path::new("dataset/motors").is_dir() => {
+            MotorCatalogue::load(Path::new("dataset/motors"))?
+        }
+        None => MotorCatalogue::bundled()?,
+    })
+}
+
+pub fn torque_check(a: &TorqueCheckArgs) -> anyhow::Result<ExitCode> {
+    let design = Design::resolve(&a.design)?;
+    let points = load_table3_points(a.points.as_deref())?;
+    let rows = table3::rows_from_points(&points);
+    let row = rows
+        .iter()
+        .find(|r| r.design == design.name && r.mass_law == a.mass_law && r.contact == a.contact)
+        .ok_or_else(|| {
+            anyhow::anyhow!(
+                "Table III has no chain for design `{}` with {:?} and {:?} contact; run `survey sim table3 --designs {} --points FILE` and pass --points FILE",
+                design.name,
+                a.mass_law,
+                a.contact,
+                a.design
+            )
+        })?;
+    let catalogue = load_motors(a.motors.as_deref())?;
+    let mass_at = |l: f64| {
+        design
+            .scaled(l, a.mass_law, a.contact)
+            .map(|d| d.mass.total_mass_kg)
+            .unwrap_or(f64::NAN)
+    };
+    let check = robot_survey::study::torque_check::torque_check(
+        row,
+        &catalogue,
+        a.actuator.as_deref().map(|id| (id, a.voltage)),
+        Some(design.geometry.leg_length_m),
+        &mass_at,
+    )?;
+    if let Some(path) = &a.plot {
+        let panels = report::study::torque_check_panels(&check);
+        plot::draw_panels(path, &panels, (760 * panels.len().max(1) as u32, 620))?;
+        eprintln!("wrote {}", path.display());
+    }
+    print(&match a.format {
+        super::sim::SimFormat::Json => report::json(&check)?,
+        super::sim::SimFormat::Text => report::study::torque_check_text(&check),
+    });
+    Ok(ExitCode::SUCCESS)
 }

@@ -331,3 +331,352 @@ pub fn table3_torque_panels(t: &Table3) -> Vec<Panel> {
         })
         .collect()
 }
+
+/// The foot study: feasible multipliers per size and axis, the feasible-length laws beside
+/// the paper's, and the fastest foot per size against the Froude prediction.
+pub fn feet_md(f: &crate::study::feet::FeetStudy) -> String {
+    let mut out = String::from(
+        "Feasible feet: multipliers of one semi-axis (others 1×) that walk with the design's own control.\n\n\
+         | design | contact | L [m] | axis | walking multipliers | shortest–longest semi-axis [m] |\n|---|---|---|---|---|---|\n",
+    );
+    for r in &f.ranges {
+        out.push_str(&format!(
+            "| {} | {} | {} | R_{} | {} | {} |\n",
+            r.design,
+            contact_name(r.contact),
+            sig(r.leg_length_m),
+            r.axis.to_uppercase(),
+            factor_runs(&r.walking_factors),
+            match (r.min_m, r.max_m) {
+                (Some(a), Some(b)) => format!("{}–{}", sig(a), sig(b)),
+                _ => "none".into(),
+            }
+        ));
+    }
+    out.push_str(
+        "\nFeasible semi-axis length against leg length, R = a·L^b over every walking foot:\n\n\
+         | design | contact | axis | a | b [95 % CI] | R² | n | paper a·L^b (R²) |\n|---|---|---|---|---|---|---|---|\n",
+    );
+    for l in &f.laws {
+        let paper = l
+            .paper
+            .map(|[a, b, r2]| format!("{a}·L^{b} ({r2})"))
+            .unwrap_or_else(|| "–".into());
+        match &l.law {
+            Some(law) => out.push_str(&format!(
+                "| {} | {} | R_{} | {:.3} | {:.3} [{:.3}, {:.3}] | {:.3} | {} | {} |\n",
+                l.design,
+                contact_name(l.contact),
+                l.axis.to_uppercase(),
+                law.a,
+                law.b,
+                law.b_ci[0],
+                law.b_ci[1],
+                law.r2,
+                law.n,
+                paper
+            )),
+            None => out.push_str(&format!(
+                "| {} | {} | R_{} | – | – | – | – | {} |\n",
+                l.design,
+                contact_name(l.contact),
+                l.axis.to_uppercase(),
+                paper
+            )),
+        }
+    }
+    out.push_str(
+        "\nFastest foot per size, against the Froude prediction from the 1× foot at the reference size (v ∝ √L):\n\n\
+         | design | contact | L [m] | foot | v [m/s] | 1× foot v [m/s] | Froude prediction [m/s] | excess | paper fastest [m/s] |\n|---|---|---|---|---|---|---|---|---|\n",
+    );
+    for b in &f.fastest {
+        out.push_str(&format!(
+            "| {} | {} | {} | R_{} × {} | {:.3} | {} | {} | {} | {} |\n",
+            b.design,
+            contact_name(b.contact),
+            sig(b.leg_length_m),
+            b.axis.to_uppercase(),
+            b.factor,
+            b.velocity_mps,
+            opt(b.velocity_1x_mps, 3),
+            b.froude_prediction_mps
+                .map(|v| format!("{v:.3} (from L = {})", sig(b.reference_leg_length_m)))
+                .unwrap_or_else(|| "–".into()),
+            b.excess_over_froude
+                .map(|e| format!("{:+.0} %", 100.0 * e))
+                .unwrap_or_else(|| "–".into()),
+            opt(b.paper_velocity_mps, 3)
+        ));
+    }
+    out
+}
+
+/// "0.5–1.3, 1.5" from sorted multipliers on a 0.1 grid.
+fn factor_runs(fs: &[f64]) -> String {
+    if fs.is_empty() {
+        return "none".into();
+    }
+    let mut runs: Vec<(f64, f64)> = Vec::new();
+    for &f in fs {
+        match runs.last_mut() {
+            Some((_, hi)) if (f - *hi - 0.1).abs() < 1e-6 => *hi = f,
+            _ => runs.push((f, f)),
+        }
+    }
+    runs.iter()
+        .map(|(a, b)| {
+            if a == b {
+                format!("{a}")
+            } else {
+                format!("{a}–{b}")
+            }
+        })
+        .collect::<Vec<_>>()
+        .join(", ")
+}
+
+/// Feasible region: every walking foot's scaled semi-axis against L, per design and axis
+/// (each axis offset slightly in L so the columns do not overlap), with the fitted laws.
+pub fn feet_panels(f: &crate::study::feet::FeetStudy) -> Vec<Panel> {
+    let mut keys: Vec<(String, ContactScaling)> = Vec::new();
+    for p in &f.points {
+        if !keys.contains(&(p.design.clone(), p.contact)) {
+            keys.push((p.design.clone(), p.contact));
+        }
+    }
+    keys.into_iter()
+        .map(|(d, c)| {
+            let series = ["x", "y", "z"]
+                .iter()
+                .enumerate()
+                .map(|(k, axis)| {
+                    let offset = [0.93, 1.0, 1.075][k];
+                    let pts: Vec<(f64, f64)> = f
+                        .points
+                        .iter()
+                        .filter(|p| p.design == d && p.contact == c && p.axis == *axis && p.walks)
+                        .map(|p| (p.leg_length_m * offset, [p.r_x_m, p.r_y_m, p.r_z_m][k]))
+                        .collect();
+                    let law = f
+                        .laws
+                        .iter()
+                        .find(|l| l.design == d && l.contact == c && l.axis == *axis)
+                        .and_then(|l| l.law.as_ref());
+                    Series {
+                        label: match law {
+                            Some(l) => {
+                                format!("R_{} = {:.2}·L^{:.2}", axis.to_uppercase(), l.a, l.b)
+                            }
+                            None => format!("R_{}", axis.to_uppercase()),
+                        },
+                        color: COLORS[k],
+                        points: pts,
+                        line: law.map(|l| (l.a, l.b)),
+                        line_range: None,
+                        band: Vec::new(),
+                    }
+                })
+                .collect();
+            Panel {
+                title: format!("{d} ({}): walking feet", contact_name(c)),
+                x_label: "leg length L [m]".into(),
+                y_label: "semi-axis [m]".into(),
+                series,
+            }
+        })
+        .collect()
+}
+
+/// `survey torque-check` as text.
+pub fn torque_check_text(c: &crate::study::torque_check::TorqueCheck) -> String {
+    let a = &c.anchor;
+    let mut out = format!(
+        "{} ({}, {} contact): minimum hip torque (Table III) against motor-torque laws\n\
+         anchor: {} ({}) stall {} N·m{} at L = {} m (robot {} kg{}); required there {} N·m\n\
+         required τ_min ∝ L^{} over {} walking sizes ({}–{} m)\n",
+        c.design,
+        law_name(c.mass_law),
+        contact_name(c.contact),
+        a.actuator_name,
+        a.actuator,
+        sig(a.stall_torque_nm),
+        a.voltage_v
+            .map(|v| format!(" at {v} V"))
+            .unwrap_or_default(),
+        a.leg_length_m,
+        sig(a.robot_mass_kg),
+        a.actuator_mass_kg
+            .map(|m| format!(", actuator {} kg", sig(m)))
+            .unwrap_or_default(),
+        a.required_nm.map(sig).unwrap_or_else(|| "–".into()),
+        opt(c.required_exponent, 2),
+        c.leg_lengths_m.len(),
+        c.leg_lengths_m.first().map(|l| sig(*l)).unwrap_or_default(),
+        c.leg_lengths_m.last().map(|l| sig(*l)).unwrap_or_default(),
+    );
+    if let (Some(b), Some([lo, hi]), Some(r2)) = (
+        c.actuator_fit_exponent,
+        c.actuator_fit_exponent_ci,
+        c.actuator_fit_r2,
+    ) {
+        out.push_str(&format!(
+            "catalogue: τ_stall ∝ M^{b:.2} [{lo:.2}, {hi:.2}], R² {r2:.3}, n = {} datasheet actuators\n",
+            c.actuator_fit_n
+        ));
+    }
+    for b in &c.bridges {
+        out.push_str(&format!("\n{}\n", b.description));
+        if let (Some(Some(f0)), Some(Some(f1))) = (
+            b.actuator_mass_fraction.first(),
+            b.actuator_mass_fraction.last(),
+        ) {
+            out.push_str(&format!(
+                "  actuator mass / robot mass: {:.3} at the smallest size, {:.3} at the largest{}\n",
+                f0,
+                f1,
+                if *f1 > 1.0 || *f0 > 1.0 {
+                    " (above 1: the bridge is impossible there)"
+                } else {
+                    ""
+                }
+            ));
+        }
+        out.push_str(&format!(
+            "  {:<22} {:>9} {:>8} {:>10} {:>10}  {}\n",
+            "law", "basis", "τ ∝ L^p", "margin min", "margin max", "verdict"
+        ));
+        for l in &b.laws {
+            let (mn, mx) = l
+                .margin
+                .iter()
+                .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), m| {
+                    (a.min(*m), b.max(*m))
+                });
+            out.push_str(&format!(
+                "  {:<22} {:>9} {:>8.2} {:>10} {:>10}  {}\n",
+                l.law,
+                l.basis,
+                l.exponent_vs_leg_length,
+                sig(mn),
+                sig(mx),
+                l.verdict
+            ));
+        }
+    }
+    out
+}
+
+/// One panel per bridge: the required minimum torque and every law's available torque.
+pub fn torque_check_panels(c: &crate::study::torque_check::TorqueCheck) -> Vec<Panel> {
+    let palette = [
+        RGBColor(0x1f, 0x77, 0xb4),
+        RGBColor(0x2c, 0xa0, 0x2c),
+        RGBColor(0x94, 0x67, 0xbd),
+        RGBColor(0xff, 0x7f, 0x0e),
+        RGBColor(0x8c, 0x56, 0x4b),
+        RGBColor(0xe3, 0x77, 0xc2),
+        RGBColor(0x17, 0xbe, 0xcf),
+        RGBColor(0xbc, 0xbd, 0x22),
+        RGBColor(0x7f, 0x7f, 0x7f),
+        RGBColor(0x00, 0x00, 0x00),
+    ];
+    let (lo, hi) = match (c.leg_lengths_m.first(), c.leg_lengths_m.last()) {
+        (Some(a), Some(b)) => (*a, *b),
+        _ => (0.02, 1.2),
+    };
+    c.bridges
+        .iter()
+        .map(|b| {
+            let mut series = vec![Series {
+                label: format!("required τ_min ({})", law_name(c.mass_law)),
+                color: RGBColor(0xd6, 0x27, 0x28),
+                points: c
+                    .leg_lengths_m
+                    .iter()
+                    .zip(&c.required_nm)
+                    .map(|(l, t)| (*l, *t))
+                    .collect(),
+                line: None,
+                line_range: None,
+                band: Vec::new(),
+            }];
+            for (k, l) in b.laws.iter().enumerate() {
+                let p = l.exponent_vs_leg_length;
+                series.push(Series {
+                    label: format!("{} (L^{p:.2})", l.law),
+                    color: palette[k % palette.len()],
+                    points: Vec::new(),
+                    line: Some((c.anchor.stall_torque_nm / c.anchor.leg_length_m.powf(p), p)),
+                    line_range: Some((lo, hi)),
+                    band: Vec::new(),
+                });
+            }
+            Panel {
+                title: match b.bridge {
+                    crate::study::torque_check::Bridge::IsometricActuator => {
+                        format!("{}: isometric actuator", c.design)
+                    }
+                    crate::study::torque_check::Bridge::FixedMassFraction => {
+                        format!("{}: fixed actuator mass fraction", c.design)
+                    }
+                },
+                x_label: "leg length L [m]".into(),
+                y_label: "hip torque [N·m]".into(),
+                series,
+            }
+        })
+        .collect()
+}
+
+/// The required hip torque of `survey predict --from design:NAME`.
+pub fn torque_need_text(t: &crate::study::torque_need::TorqueNeed) -> String {
+    let mut out = format!(
+        "\nrequired minimum hip torque of {} at L = {} m (Table III, {}, {} contact: τ_min = {:.3} m·g·L, bracket [{:.3}, {:.3}], walking sizes {}–{} m)\n",
+        t.design,
+        t.leg_length_m,
+        law_name(t.mass_law),
+        contact_name(t.contact),
+        t.min_torque_over_mgl,
+        t.bracket_over_mgl[0],
+        t.bracket_over_mgl[1],
+        sig(t.walking_range_m[0]),
+        sig(t.walking_range_m[1])
+    );
+    for q in &t.torques {
+        out.push_str(&format!(
+            "  mass {:>9} kg ({}){}: τ_min {} N·m [{}, {}]\n",
+            sig(q.mass_kg),
+            q.mass_from,
+            q.mass_interval_kg
+                .map(|[a, b]| format!(" [{}, {}] kg", sig(a), sig(b)))
+                .unwrap_or_default(),
+            sig(q.required_nm),
+            sig(q.required_interval_nm[0]),
+            sig(q.required_interval_nm[1])
+        ));
+    }
+    out.push_str(&format!(
+        "actuators with stall torque ≥ {}× the first requirement (lightest first):\n",
+        t.torque_margin
+    ));
+    if t.actuators.iter().all(|a| !a.meets_margin) {
+        out.push_str(
+            "  none in the catalogue (dataset/motors/actuators.toml); the strongest catalogued:\n",
+        );
+    }
+    for a in t.actuators.iter().take(8) {
+        out.push_str(&format!(
+            "  {:<34} {:>8} {:>9} N·m stall{} margin {:.1}×\n",
+            a.name,
+            a.mass_kg
+                .map(|m| format!("{} kg", sig(m)))
+                .unwrap_or_else(|| "mass ?".into()),
+            sig(a.stall_torque_nm),
+            a.voltage_v
+                .map(|v| format!(" at {v} V,"))
+                .unwrap_or(",".into()),
+            a.margin
+        ));
+    }
+    out
+}

@@ -5,14 +5,18 @@
 //!   bracketing and bisection (the problem, "walks at τ?", separate from the solver).
 //! * [`table3`]: the paper's Table III — minimum torque and gait over 0.02–1.2 m, both mass
 //!   laws, fitted power laws.
+//! * [`feet`]: the foot study — each semi-axis scaled 0.5–2.0× at three sizes.
 //! * [`sweep`]: points files that make sweeps resumable and shardable, and their merge.
 
 pub mod error;
+pub mod feet;
 pub mod min_torque;
 pub mod paper;
 pub mod scaling;
 pub mod sweep;
 pub mod table3;
+pub mod torque_check;
+pub mod torque_need;
 
 pub use error::StudyError;
 pub use min_torque::{MinTorqueOptions, MinTorqueResult, min_torque};

@@ -156,12 +156,7 @@ impl Table3Spec {
         let designs = self
             .designs
             .iter()
-            .map(|d| {
-                let json = serde_json::to_string(d).unwrap_or_default();
-                let hash = Sha256::digest(json.as_bytes());
-                let hex: String = hash.iter().take(8).map(|b| format!("{b:02x}")).collect();
-                (d.name.clone(), hex)
-            })
+            .map(|d| (d.name.clone(), design_hash(d)))
             .collect();
         let fp = Fingerprint {
             version: env!("CARGO_PKG_VERSION"),
@@ -180,6 +175,14 @@ impl Table3Spec {
     pub fn points_total(&self) -> usize {
         self.chains().len() * self.leg_lengths_m.len()
     }
+}
+
+/// The first 16 hex digits of the SHA-256 of a design's full parameter set (JSON): a
+/// points file names the exact designs it was made with.
+pub fn design_hash(d: &Design) -> String {
+    let json = serde_json::to_string(d).unwrap_or_default();
+    let hash = Sha256::digest(json.as_bytes());
+    hash.iter().take(8).map(|b| format!("{b:02x}")).collect()
 }
 
 /// One size of one chain.
@@ -534,6 +537,49 @@ pub fn assemble(spec: &Table3Spec, points: &[Table3Point]) -> Result<Table3, Stu
         ),
         rows,
     })
+}
+
+/// Table III rows from a set of points alone (e.g. a points file), one per design × mass
+/// law × contact rule in order of first appearance.
+pub fn rows_from_points(points: &[Table3Point]) -> Vec<Table3Row> {
+    let mut keys: Vec<(String, MassLaw, ContactScaling)> = Vec::new();
+    for p in points {
+        let k = (p.design.clone(), p.mass_law, p.contact);
+        if !keys.contains(&k) {
+            keys.push(k);
+        }
+    }
+    keys.into_iter()
+        .map(|(d, m, c)| {
+            let mut pts: Vec<Table3Point> = points
+                .iter()
+                .filter(|p| p.design == d && p.mass_law == m && p.contact == c)
+                .cloned()
+                .collect();
+            pts.sort_by(|a, b| a.leg_length_m.total_cmp(&b.leg_length_m));
+            row(&d, m, c, pts)
+        })
+        .collect()
+}
+
+/// The project's Table III points (`reports/table3.points.csv`, made by
+/// `survey sim table3 --out reports/`), compiled in for `survey predict` and
+/// `survey torque-check`.
+pub fn bundled_points() -> Result<Vec<Table3Point>, StudyError> {
+    const TEXT: &str = include_str!("../../reports/table3.points.csv");
+    let mut reader = csv::ReaderBuilder::new()
+        .comment(Some(b'#'))
+        .from_reader(TEXT.as_bytes());
+    reader
+        .deserialize()
+        .enumerate()
+        .map(|(i, r)| {
+            r.map_err(|e| StudyError::Data {
+                origin: format!("reports/table3.points.csv (bundled), row {}", i + 1),
+                message: e.to_string(),
+            })
+        })
+        .collect()
 }
 
 fn row(name: &str, m: MassLaw, c: ContactScaling, pts: Vec<Table3Point>) -> Table3Row {

@@ -1,0 +1,176 @@
+//! The designer's torque question (`survey predict --from design:NAME`): how much hip
+//! torque does a walker of this design need at leg length L, and which catalogued actuator
+//! delivers it with margin?
+//!
+//! Table III gives the minimum torque in units of m·g·L along the design's chain (nearly
+//! constant under similarity; it drifts with size under fixed material). At the target L it
+//! is interpolated (log–log) between the walking sizes, with the bisection bracket as its
+//! uncertainty, and multiplied by m·g·L for each candidate mass: the survey class fit's
+//! prediction (with its prediction interval) and the design scaled by m ∝ L² and L³.
+
+use serde::Serialize;
+
+use super::StudyError;
+use super::table3::Table3Point;
+use crate::motors::MotorCatalogue;
+use crate::sim::{ContactScaling, GRAVITY_MPS2, MassLaw};
+
+#[derive(Clone, Debug, Serialize)]
+pub struct TorqueAtMass {
+    /// Where the mass comes from.
+    pub mass_from: String,
+    pub mass_kg: f64,
+    /// The mass's own interval (the class fit's prediction interval), when it has one.
+    pub mass_interval_kg: Option<[f64; 2]>,
+    pub required_nm: f64,
+    /// Bracket of τ_min/(mgL) × the mass interval.
+    pub required_interval_nm: [f64; 2],
+}
+
+#[derive(Clone, Debug, Serialize)]
+pub struct ActuatorOption {
+    pub id: String,
+    pub name: String,
+    pub mass_kg: Option<f64>,
+    pub voltage_v: Option<f64>,
+    pub stall_torque_nm: f64,
+    pub continuous_torque_nm: Option<f64>,
+    /// Stall torque / required torque (of the first mass).
+    pub margin: f64,
+    /// False for the strongest actuators listed when none meets the margin.
+    pub meets_margin: bool,
+}
+
+#[derive(Clone, Debug, Serialize)]
+pub struct TorqueNeed {
+    pub design: String,
+    pub leg_length_m: f64,
+    /// The Table III chain used.
+    pub mass_law: MassLaw,
+    pub contact: ContactScaling,
+    /// τ_min/(m·g·L) at L and its bracket [failing, walking].
+    pub min_torque_over_mgl: f64,
+    pub bracket_over_mgl: [f64; 2],
+    /// Walking sizes of the chain [m] (the range interpolated over).
+    pub walking_range_m: [f64; 2],
+    pub torques: Vec<TorqueAtMass>,
+    /// Required margin of stall torque over the requirement.
+    pub torque_margin: f64,
+    /// Catalogued actuators whose stall torque ≥ margin × the first requirement, lightest first.
+    pub actuators: Vec<ActuatorOption>,
+}
+
+/// `masses`: (label, mass, interval) candidates; the first one sizes the actuators.
+#[allow(clippy::too_many_arguments)]
+pub fn torque_need(
+    points: &[Table3Point],
+    design: &str,
+    mass_law: MassLaw,
+    contact: ContactScaling,
+    leg_length_m: f64,
+    masses: &[(String, f64, Option<[f64; 2]>)],
+    catalogue: Option<&MotorCatalogue>,
+    torque_margin: f64,
+) -> Result<TorqueNeed, StudyError> {
+    let chain: Vec<&Table3Point> = points
+        .iter()
+        .filter(|p| p.design == design && p.mass_law == mass_law && p.contact == contact)
+        .collect();
+    let mut walking: Vec<&Table3Point> = chain.iter().copied().filter(|p| p.walks).collect();
+    walking.sort_by(|a, b| a.leg_length_m.total_cmp(&b.leg_length_m));
+    let (Some(first), Some(last)) = (walking.first(), walking.last()) else {
+        return Err(StudyError::InvalidOption {
+            option: "design".into(),
+            reason: format!(
+                "Table III has no walking size for design `{design}` ({mass_law:?}, {contact:?} contact)"
+            ),
+        });
+    };
+    let range = [first.leg_length_m, last.leg_length_m];
+    let interp = |get: fn(&Table3Point) -> Option<f64>| -> Option<f64> {
+        let pts: Vec<(f64, f64)> = walking
+            .iter()
+            .filter_map(|p| get(p).filter(|v| *v > 0.0).map(|y| (p.leg_length_m, y)))
+            .collect();
+        if let Some(&(_, y)) = pts.iter().find(|(x, _)| *x == leg_length_m) {
+            return Some(y);
+        }
+        let w = pts
+            .windows(2)
+            .find(|w| w[0].0 < leg_length_m && leg_length_m < w[1].0)?;
+        let t = (leg_length_m / w[0].0).ln() / (w[1].0 / w[0].0).ln();
+        Some((w[0].1.ln() + t * (w[1].1 / w[0].1).ln()).exp())
+    };
+    let outside = || StudyError::InvalidOption {
+        option: "leg_length".into(),
+        reason: format!(
+            "{leg_length_m} m is outside the sizes at which {design} walks in Table III \
+             ({}–{} m, {mass_law:?}, {contact:?} contact): no interpolation there",
+            range[0], range[1]
+        ),
+    };
+    let ratio = interp(|p| p.min_torque_over_mgl).ok_or_else(outside)?;
+    let lo = interp(|p| p.bracket_lo_nm.map(|v| v / p.mgl_nm)).unwrap_or(ratio);
+    let hi = interp(|p| p.bracket_hi_nm.map(|v| v / p.mgl_nm)).unwrap_or(ratio);
+    let gl = GRAVITY_MPS2 * leg_length_m;
+    let torques: Vec<TorqueAtMass> = masses
+        .iter()
+        .map(|(label, m, iv)| {
+            let [m_lo, m_hi] = iv.unwrap_or([*m, *m]);
+            TorqueAtMass {
+                mass_from: label.clone(),
+                mass_kg: *m,
+                mass_interval_kg: *iv,
+                required_nm: ratio * m * gl,
+                required_interval_nm: [lo.min(ratio) * m_lo * gl, hi.max(ratio) * m_hi * gl],
+            }
+        })
+        .collect();
+    let mut actuators = Vec::new();
+    if let (Some(cat), Some(need)) = (catalogue, torques.first()) {
+        let all: Vec<ActuatorOption> = cat
+            .actuators
+            .iter()
+            .filter_map(|a| {
+                let r = a.rating(None)?;
+                let margin = r.stall_torque_nm / need.required_nm;
+                Some(ActuatorOption {
+                    id: a.id.clone(),
+                    name: a.name.clone(),
+                    mass_kg: a.mass_kg,
+                    voltage_v: r.voltage_v,
+                    stall_torque_nm: r.stall_torque_nm,
+                    continuous_torque_nm: a.continuous_torque_nm,
+                    margin,
+                    meets_margin: margin >= torque_margin,
+                })
+            })
+            .collect();
+        actuators = all.iter().filter(|a| a.meets_margin).cloned().collect();
+        actuators.sort_by(|a, b| {
+            a.mass_kg
+                .unwrap_or(f64::INFINITY)
+                .total_cmp(&b.mass_kg.unwrap_or(f64::INFINITY))
+                .then(a.stall_torque_nm.total_cmp(&b.stall_torque_nm))
+        });
+        if actuators.is_empty() {
+            // None is strong enough: show the strongest, so the shortfall is visible.
+            let mut strongest = all;
+            strongest.sort_by(|a, b| b.stall_torque_nm.total_cmp(&a.stall_torque_nm));
+            strongest.truncate(3);
+            actuators = strongest;
+        }
+    }
+    Ok(TorqueNeed {
+        design: design.to_string(),
+        leg_length_m,
+        mass_law,
+        contact,
+        min_torque_over_mgl: ratio,
+        bracket_over_mgl: [lo, hi],
+        walking_range_m: range,
+        torques,
+        torque_margin,
+        actuators,
+    })
+}
