@@ -175,29 +175,16 @@ pub fn feet(a: &FeetArgs) -> anyhow::Result<ExitCode> {
     spec.mass_law = a.mass_law;
     spec.duration_at_design_size_s = a.duration;
     let shard = a.shard.unwrap_or(Shard::WHOLE);
-    let points = a
-        .points
-        .clone()
-        .or_else(|| a.out.as_ref().map(|d| d.join("feet.points.csv")));
-    if shard != Shard::WHOLE && points.is_none() {
-        anyhow::bail!("--shard {shard} writes its points to a file: give --points FILE");
-    }
-    if let Some(dir) = &a.out {
-        std::fs::create_dir_all(dir)
-            .map_err(|e| anyhow::anyhow!("cannot create {}: {e}", dir.display()))?;
-    }
+    let points = sweep_points(&a.points, &a.out, "feet.points.csv", shard)?;
     let total = spec
         .units()
         .iter()
         .enumerate()
         .filter(|(k, _)| shard.takes(*k))
         .count();
-    let bar = indicatif::ProgressBar::new(total as u64);
-    bar.set_style(
-        indicatif::ProgressStyle::with_template(
-            "feet [{bar:30}] {pos}/{len} feet, {elapsed} (eta {eta})",
-        )
-        .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
+    let bar = progress(
+        total,
+        "feet [{bar:30}] {pos}/{len} feet, {elapsed} (eta {eta})",
     );
     let run = run_feet(&spec, shard, points.as_deref(), &|_, _| bar.inc(1))?;
     bar.finish_and_clear();
@@ -241,6 +228,36 @@ pub fn feet(a: &FeetArgs) -> anyhow::Result<ExitCode> {
     }
     print(&render(a.format)?);
     Ok(ExitCode::SUCCESS)
+}
+
+/// The points file of a sweep (--points, else DIR/NAME under --out), checked against the
+/// shard, and the output folder created.
+fn sweep_points(
+    points: &Option<PathBuf>,
+    out: &Option<PathBuf>,
+    name: &str,
+    shard: Shard,
+) -> anyhow::Result<Option<PathBuf>> {
+    let points = points
+        .clone()
+        .or_else(|| out.as_ref().map(|d| d.join(name)));
+    if shard != Shard::WHOLE && points.is_none() {
+        anyhow::bail!("--shard {shard} writes its points to a file: give --points FILE");
+    }
+    if let Some(dir) = out {
+        std::fs::create_dir_all(dir)
+            .map_err(|e| anyhow::anyhow!("cannot create {}: {e}", dir.display()))?;
+    }
+    Ok(points)
+}
+
+fn progress(total: usize, template: &str) -> indicatif::ProgressBar {
+    let bar = indicatif::ProgressBar::new(total as u64);
+    bar.set_style(
+        indicatif::ProgressStyle::with_template(template)
+            .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
+    );
+    bar
 }
 
 struct Bar(indicatif::ProgressBar);
@@ -289,17 +306,7 @@ pub fn table3_spec(a: &Table3Args) -> anyhow::Result<Table3Spec> {
 pub fn table3(a: &Table3Args) -> anyhow::Result<ExitCode> {
     let spec = table3_spec(a)?;
     let shard = a.shard.unwrap_or(Shard::WHOLE);
-    let points = a
-        .points
-        .clone()
-        .or_else(|| a.out.as_ref().map(|d| d.join("table3.points.csv")));
-    if shard != Shard::WHOLE && points.is_none() {
-        anyhow::bail!("--shard {shard} writes its points to a file: give --points FILE");
-    }
-    if let Some(dir) = &a.out {
-        std::fs::create_dir_all(dir)
-            .map_err(|e| anyhow::anyhow!("cannot create {}: {e}", dir.display()))?;
-    }
+    let points = sweep_points(&a.points, &a.out, "table3.points.csv", shard)?;
     let total = spec
         .chains()
         .iter()
@@ -307,12 +314,9 @@ pub fn table3(a: &Table3Args) -> anyhow::Result<ExitCode> {
         .filter(|(k, _)| shard.takes(*k))
         .count()
         * spec.leg_lengths_m.len();
-    let bar = indicatif::ProgressBar::new(total as u64);
-    bar.set_style(
-        indicatif::ProgressStyle::with_template(
-            "table3 [{bar:30}] {pos}/{len} sizes, {elapsed} (eta {eta}) {msg}",
-        )
-        .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
+    let bar = progress(
+        total,
+        "table3 [{bar:30}] {pos}/{len} sizes, {elapsed} (eta {eta}) {msg}",
     );
     let run = run_table3(&spec, shard, points.as_deref(), &Bar(bar.clone()))?;
     bar.finish_and_clear();

@@ -8,16 +8,14 @@
 //! Points are independent (no warm start), so every point is a unit of `--shard` and of
 //! the resumable points file.
 
-use std::collections::HashMap;
 use std::path::Path;
-use std::sync::Mutex;
 
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 use super::StudyError;
 use super::scaling::{StudyLaw, law};
-use super::sweep::{PointLog, Shard, SweepPoint, spec_line};
+use super::sweep::{Shard, SweepPoint, append_to, open_log, spec_line};
 use crate::sim::{ContactScaling, Design, MassLaw, WalkOptions, simulate_walk};
 
 pub const FEET_KIND: &str = "feet";
@@ -280,14 +278,7 @@ pub fn run_feet(
     on_point: &(dyn Fn(&FootPoint, bool) + Sync),
 ) -> Result<FeetRun, StudyError> {
     spec.check()?;
-    let (log, done): (Option<Mutex<PointLog>>, Vec<FootPoint>) = match points_file {
-        Some(p) => {
-            let (log, done) = PointLog::open::<FootPoint>(p, &spec.header())?;
-            (Some(Mutex::new(log)), done)
-        }
-        None => (None, Vec::new()),
-    };
-    let done: HashMap<String, FootPoint> = done.into_iter().map(|p| (p.key(), p)).collect();
+    let (log, done) = open_log::<FootPoint>(points_file, &spec.header())?;
     let units: Vec<_> = spec
         .units()
         .into_iter()
@@ -306,14 +297,7 @@ pub fn run_feet(
                 return Ok(p.clone());
             }
             let p = foot_point(spec, design, c, l, axis, f)?;
-            if let Some(log) = &log {
-                log.lock()
-                    .map_err(|_| StudyError::InvalidOption {
-                        option: "points".into(),
-                        reason: "a worker panicked while writing the points file".into(),
-                    })?
-                    .append(&p)?;
-            }
+            append_to(log.as_ref(), &p)?;
             simulated.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
             on_point(&p, false);
             Ok(p)

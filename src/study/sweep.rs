@@ -158,6 +158,46 @@ impl PointLog {
     }
 }
 
+/// Opens the points file of a sweep when one is given: the log to append to (shared by the
+/// workers) and the points already done, by key.
+pub type OpenedLog<R> = (
+    Option<std::sync::Mutex<PointLog>>,
+    std::collections::HashMap<String, R>,
+);
+
+pub fn open_log<R: SweepPoint>(
+    path: Option<&Path>,
+    header: &str,
+) -> Result<OpenedLog<R>, StudyError> {
+    match path {
+        Some(p) => {
+            let (log, done) = PointLog::open::<R>(p, header)?;
+            Ok((
+                Some(std::sync::Mutex::new(log)),
+                done.into_iter().map(|r| (r.key(), r)).collect(),
+            ))
+        }
+        None => Ok((None, Default::default())),
+    }
+}
+
+/// Appends a finished point to the shared log, if any.
+pub fn append_to<R: SweepPoint>(
+    log: Option<&std::sync::Mutex<PointLog>>,
+    point: &R,
+) -> Result<(), StudyError> {
+    match log {
+        Some(log) => log
+            .lock()
+            .map_err(|_| StudyError::InvalidOption {
+                option: "points".into(),
+                reason: "a worker panicked while writing the points file".into(),
+            })?
+            .append(point),
+        None => Ok(()),
+    }
+}
+
 fn truncate(s: &str, n: usize) -> String {
     if s.chars().count() <= n {
         s.to_string()

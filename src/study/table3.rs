@@ -26,7 +26,7 @@ use sha2::{Digest, Sha256};
 use super::StudyError;
 use super::min_torque::{MinTorqueOptions, min_torque};
 use super::scaling::{StudyLaw, law};
-use super::sweep::{PointLog, Shard, SweepPoint, spec_line};
+use super::sweep::{PointLog, Shard, SweepPoint, append_to, open_log, spec_line};
 use crate::sim::{
     ContactScaling, Design, GRAVITY_MPS2, MassLaw, WalkOptions, WalkReport, simulate_walk,
 };
@@ -323,15 +323,7 @@ pub fn run_table3(
     observer: &dyn Observer,
 ) -> Result<Table3Run, StudyError> {
     spec.check()?;
-    let header = spec.header();
-    let (log, done): (Option<Mutex<PointLog>>, Vec<Table3Point>) = match points_file {
-        Some(path) => {
-            let (log, done) = PointLog::open::<Table3Point>(path, &header)?;
-            (Some(Mutex::new(log)), done)
-        }
-        None => (None, Vec::new()),
-    };
-    let done: HashMap<String, Table3Point> = done.into_iter().map(|p| (p.key(), p)).collect();
+    let (log, done) = open_log::<Table3Point>(points_file, &spec.header())?;
     let chains: Vec<_> = spec
         .chains()
         .into_iter()
@@ -391,14 +383,7 @@ fn run_chain(
             Some(p) => (p.clone(), true),
             None => {
                 let p = table3_point(spec, design, mass_law, contact, l, warm)?;
-                if let Some(log) = log {
-                    log.lock()
-                        .map_err(|_| StudyError::InvalidOption {
-                            option: "points".into(),
-                            reason: "a worker panicked while writing the points file".into(),
-                        })?
-                        .append(&p)?;
-                }
+                append_to(log, &p)?;
                 (p, false)
             }
         };

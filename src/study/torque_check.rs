@@ -125,7 +125,9 @@ pub fn interpolate_bracket(points: &[Table3Point], leg_length_m: f64) -> Option<
     ])
 }
 
-fn interpolate(
+/// Log–log interpolation of a column over the walking points (exact at a point; None
+/// outside them).
+pub(crate) fn interpolate(
     points: &[Table3Point],
     l: f64,
     get: fn(&Table3Point) -> Option<f64>,

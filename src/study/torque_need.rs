@@ -12,6 +12,7 @@ use serde::Serialize;
 
 use super::StudyError;
 use super::table3::Table3Point;
+use super::torque_check::interpolate;
 use crate::motors::MotorCatalogue;
 use crate::sim::{ContactScaling, GRAVITY_MPS2, MassLaw};
 
@@ -72,13 +73,16 @@ pub fn torque_need(
     catalogue: Option<&MotorCatalogue>,
     torque_margin: f64,
 ) -> Result<TorqueNeed, StudyError> {
-    let chain: Vec<&Table3Point> = points
+    let chain: Vec<Table3Point> = points
         .iter()
         .filter(|p| p.design == design && p.mass_law == mass_law && p.contact == contact)
+        .cloned()
         .collect();
-    let mut walking: Vec<&Table3Point> = chain.iter().copied().filter(|p| p.walks).collect();
-    walking.sort_by(|a, b| a.leg_length_m.total_cmp(&b.leg_length_m));
-    let (Some(first), Some(last)) = (walking.first(), walking.last()) else {
+    let walking = || chain.iter().filter(|p| p.walks).map(|p| p.leg_length_m);
+    let (Some(first), Some(last)) = (
+        walking().min_by(f64::total_cmp),
+        walking().max_by(f64::total_cmp),
+    ) else {
         return Err(StudyError::InvalidOption {
             option: "design".into(),
             reason: format!(
@@ -86,21 +90,8 @@ pub fn torque_need(
             ),
         });
     };
-    let range = [first.leg_length_m, last.leg_length_m];
-    let interp = |get: fn(&Table3Point) -> Option<f64>| -> Option<f64> {
-        let pts: Vec<(f64, f64)> = walking
-            .iter()
-            .filter_map(|p| get(p).filter(|v| *v > 0.0).map(|y| (p.leg_length_m, y)))
-            .collect();
-        if let Some(&(_, y)) = pts.iter().find(|(x, _)| *x == leg_length_m) {
-            return Some(y);
-        }
-        let w = pts
-            .windows(2)
-            .find(|w| w[0].0 < leg_length_m && leg_length_m < w[1].0)?;
-        let t = (leg_length_m / w[0].0).ln() / (w[1].0 / w[0].0).ln();
-        Some((w[0].1.ln() + t * (w[1].1 / w[0].1).ln()).exp())
-    };
+    let range = [first, last];
+    let interp = |get: fn(&Table3Point) -> Option<f64>| interpolate(&chain, leg_length_m, get);
     let outside = || StudyError::InvalidOption {
         option: "leg_length".into(),
         reason: format!(
@@ -110,7 +101,8 @@ pub fn torque_need(
         ),
     };
     let ratio = interp(|p| p.min_torque_over_mgl).ok_or_else(outside)?;
-    let lo = interp(|p| p.bracket_lo_nm.map(|v| v / p.mgl_nm)).unwrap_or(ratio);
+    let lo =
+        interp(|p| p.bracket_lo_nm.map(|v| v / p.mgl_nm).filter(|v| *v > 0.0)).unwrap_or(ratio);
     let hi = interp(|p| p.bracket_hi_nm.map(|v| v / p.mgl_nm)).unwrap_or(ratio);
     let gl = GRAVITY_MPS2 * leg_length_m;
     let torques: Vec<TorqueAtMass> = masses
