@@ -200,3 +200,40 @@ fn paper_sizes_are_log_spaced_and_include_the_anchors() {
         assert!(w[1] > w[0] && (r - step).abs() < 0.5 * step, "{ls:?}");
     }
 }
+
+/// The committed study (reports/table3.points.csv, read by `survey predict` and
+/// `survey torque-check`): all 3 designs × 2 mass laws × 2 contact rules at 36 sizes; under
+/// similar contact the exponents of dynamic similarity (0.5; 3 for m ∝ L², 4 for m ∝ L³; 1
+/// against m·L) lie within 0.01 of the fits; under fixed material every row says which
+/// sizes walk.
+#[test]
+fn bundled_table3_covers_every_chain_and_obeys_similarity() {
+    let points = robot_survey::study::table3::bundled_points().expect("bundled points");
+    let rows = robot_survey::study::table3::rows_from_points(&points);
+    assert_eq!(rows.len(), 12);
+    for r in &rows {
+        assert_eq!(
+            r.sizes_total, 36,
+            "{} {:?} {:?}",
+            r.design, r.mass_law, r.contact
+        );
+        assert_eq!(r.sizes_walking + r.sizes_not_walking_m.len(), 36);
+        if r.contact == ContactScaling::Similar {
+            assert_eq!(r.sizes_walking, 36);
+            let tau = if r.mass_law == MassLaw::L2 { 3.0 } else { 4.0 };
+            for (got, want) in [
+                (r.velocity_exponent, 0.5),
+                (r.torque_exponent, tau),
+                (r.torque_vs_mass_length_exponent, 1.0),
+            ] {
+                let got = got.expect("fit");
+                assert!(
+                    (got - want).abs() < 0.01,
+                    "{} {:?}: {got} vs {want}",
+                    r.design,
+                    r.mass_law
+                );
+            }
+        }
+    }
+}
