@@ -92,15 +92,25 @@ pub struct Table3Args {
     /// Largest torque tried, in units of m·g·L.
     #[arg(long, default_value_t = 2.0)]
     pub cap: f64,
-    /// Points file: finished sizes are appended as they finish and skipped on a re-run.
+    #[command(flatten)]
+    pub sweep: SweepArgs,
+}
+
+/// Where a sweep keeps its points and writes its outputs.
+#[derive(Args, Debug)]
+pub struct SweepArgs {
+    /// Points file: finished points are appended as they finish and skipped on a re-run
+    /// (default: DIR/<study>.points.csv under --out).
     #[arg(long, value_name = "FILE")]
     pub points: Option<PathBuf>,
-    /// Run only slice i of n (chains k with k mod n = i − 1); needs --points.
+    /// Run only slice i of n (table3: chains, feet: single feet, k mod n = i − 1); needs
+    /// --points.
     #[arg(long, value_name = "i/n")]
     pub shard: Option<Shard>,
-    /// Write table3.{md,tex,csv,json}, table3-velocity.svg and table3-torque.svg here.
+    /// Write the tables (md, tex/json, csv) and figures here.
     #[arg(long, value_name = "DIR")]
     pub out: Option<PathBuf>,
+    /// md, tex, csv or json (feet: tex prints md; csv is the points).
     #[arg(long, value_enum, default_value_t)]
     pub format: TableFormat,
 }
@@ -147,17 +157,8 @@ pub struct FeetArgs {
     /// Simulated time at the design's own size [s]; ∝ √L elsewhere.
     #[arg(long, default_value_t = 25.0)]
     pub duration: f64,
-    /// Points file (resumable); default DIR/feet.points.csv under --out.
-    #[arg(long, value_name = "FILE")]
-    pub points: Option<PathBuf>,
-    #[arg(long, value_name = "i/n")]
-    pub shard: Option<Shard>,
-    /// Write feet.{md,json,csv} and feet.svg here.
-    #[arg(long, value_name = "DIR")]
-    pub out: Option<PathBuf>,
-    /// md or json (csv: the points).
-    #[arg(long, value_enum, default_value_t)]
-    pub format: TableFormat,
+    #[command(flatten)]
+    pub sweep: SweepArgs,
 }
 
 pub fn feet(a: &FeetArgs) -> anyhow::Result<ExitCode> {
@@ -174,8 +175,8 @@ pub fn feet(a: &FeetArgs) -> anyhow::Result<ExitCode> {
     }
     spec.mass_law = a.mass_law;
     spec.duration_at_design_size_s = a.duration;
-    let shard = a.shard.unwrap_or(Shard::WHOLE);
-    let points = sweep_points(&a.points, &a.out, "feet.points.csv", shard)?;
+    let shard = a.sweep.shard.unwrap_or(Shard::WHOLE);
+    let points = sweep_points(&a.sweep, "feet.points.csv", shard)?;
     let total = spec
         .units()
         .iter()
@@ -196,9 +197,6 @@ pub fn feet(a: &FeetArgs) -> anyhow::Result<ExitCode> {
         );
         return Ok(ExitCode::SUCCESS);
     };
-    if let Some(p) = &points {
-        sweep::write_points(p, &spec.header(), &study.points)?;
-    }
     let render = |f: TableFormat| -> anyhow::Result<String> {
         Ok(match f {
             TableFormat::Md | TableFormat::Tex => report::study::feet_md(&study),
@@ -212,7 +210,7 @@ pub fn feet(a: &FeetArgs) -> anyhow::Result<ExitCode> {
             }
         })
     };
-    if let Some(dir) = &a.out {
+    if let Some(dir) = &a.sweep.out {
         for (f, ext) in [
             (TableFormat::Md, "md"),
             (TableFormat::Json, "json"),
@@ -226,18 +224,14 @@ pub fn feet(a: &FeetArgs) -> anyhow::Result<ExitCode> {
         plot::draw_panels(&path, &panels, (520 * n, 520))?;
         eprintln!("wrote {}", path.display());
     }
-    print(&render(a.format)?);
+    print(&render(a.sweep.format)?);
     Ok(ExitCode::SUCCESS)
 }
 
 /// The points file of a sweep (--points, else DIR/NAME under --out), checked against the
 /// shard, and the output folder created.
-fn sweep_points(
-    points: &Option<PathBuf>,
-    out: &Option<PathBuf>,
-    name: &str,
-    shard: Shard,
-) -> anyhow::Result<Option<PathBuf>> {
+fn sweep_points(a: &SweepArgs, name: &str, shard: Shard) -> anyhow::Result<Option<PathBuf>> {
+    let (points, out) = (&a.points, &a.out);
     let points = points
         .clone()
         .or_else(|| out.as_ref().map(|d| d.join(name)));
@@ -305,8 +299,8 @@ pub fn table3_spec(a: &Table3Args) -> anyhow::Result<Table3Spec> {
 
 pub fn table3(a: &Table3Args) -> anyhow::Result<ExitCode> {
     let spec = table3_spec(a)?;
-    let shard = a.shard.unwrap_or(Shard::WHOLE);
-    let points = sweep_points(&a.points, &a.out, "table3.points.csv", shard)?;
+    let shard = a.sweep.shard.unwrap_or(Shard::WHOLE);
+    let points = sweep_points(&a.sweep, "table3.points.csv", shard)?;
     let total = spec
         .chains()
         .iter()
@@ -332,12 +326,6 @@ pub fn table3(a: &Table3Args) -> anyhow::Result<ExitCode> {
         );
         return Ok(ExitCode::SUCCESS);
     };
-    if let Some(p) = &points {
-        // A complete run leaves its points file in canonical order (what merge writes).
-        let mut all = run.points.clone();
-        all.sort_by_key(sweep::SweepPoint::key);
-        sweep::write_points(p, &spec.header(), &all)?;
-    }
     let paper = PaperTable3::bundled().ok();
     let render = |f: TableFormat| -> anyhow::Result<String> {
         Ok(match f {
@@ -347,7 +335,7 @@ pub fn table3(a: &Table3Args) -> anyhow::Result<ExitCode> {
             TableFormat::Json => report::json(&table)?,
         })
     };
-    if let Some(dir) = &a.out {
+    if let Some(dir) = &a.sweep.out {
         for (f, ext) in [
             (TableFormat::Md, "md"),
             (TableFormat::Tex, "tex"),
@@ -372,7 +360,7 @@ pub fn table3(a: &Table3Args) -> anyhow::Result<ExitCode> {
             eprintln!("wrote {}", path.display());
         }
     }
-    print(&render(a.format)?);
+    print(&render(a.sweep.format)?);
     Ok(ExitCode::SUCCESS)
 }
 
@@ -411,9 +399,8 @@ fn merge_kind<R: sweep::SweepPoint + PartialEq>(
     inputs: &[PathBuf],
     out: &Path,
 ) -> anyhow::Result<usize> {
-    let (header, mut rows) = sweep::merge::<R>(inputs)?;
-    rows.sort_by_key(|p| p.key());
-    sweep::write_points(out, &header, &rows)?;
+    let (header, rows) = sweep::merge::<R>(inputs)?;
+    sweep::finish_points(out, &header, &rows)?;
     Ok(rows.len())
 }
 

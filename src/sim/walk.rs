@@ -357,7 +357,8 @@ fn interp(samples: &[TrajectorySample], t: f64, f: impl Fn(&TrajectorySample) ->
     f(a) * (1.0 - w) + f(b) * w
 }
 
-fn mean_sd(v: &[f64]) -> (f64, f64) {
+/// Mean and sample standard deviation (n − 1); NaN for no values, sd 0 for one.
+pub fn mean_sd(v: &[f64]) -> (f64, f64) {
     if v.is_empty() {
         return (f64::NAN, f64::NAN);
     }

@@ -15,7 +15,7 @@ use serde::{Deserialize, Serialize};
 
 use super::StudyError;
 use super::scaling::{StudyLaw, law};
-use super::sweep::{Shard, SweepPoint, append_to, open_log, spec_line};
+use super::sweep::{Shard, SweepPoint, append_to, finish_points, open_log, spec_line};
 use crate::sim::{ContactScaling, Design, MassLaw, WalkOptions, simulate_walk};
 
 pub const FEET_KIND: &str = "feet";
@@ -150,11 +150,18 @@ pub struct FootPoint {
 
 impl SweepPoint for FootPoint {
     fn key(&self) -> String {
-        format!(
-            "{}/{:?}/{}/{}/{}",
-            self.design, self.contact, self.leg_length_m, self.axis, self.factor
+        foot_key(
+            &self.design,
+            self.contact,
+            self.leg_length_m,
+            &self.axis,
+            self.factor,
         )
     }
+}
+
+fn foot_key(design: &str, c: ContactScaling, l: f64, axis: &str, factor: f64) -> String {
+    format!("{design}/{c:?}/{l}/{axis}/{factor}")
 }
 
 /// Feasible multipliers of one semi-axis at one size.
@@ -291,7 +298,7 @@ pub fn run_feet(
         .par_iter()
         .map(|&(c, d, l, axis, f)| {
             let design = &spec.designs[d];
-            let key = format!("{}/{c:?}/{l}/{}/{f}", design.name, AXES[axis]);
+            let key = foot_key(&design.name, c, l, AXES[axis], f);
             if let Some(p) = done.get(&key) {
                 on_point(p, true);
                 return Ok(p.clone());
@@ -304,6 +311,9 @@ pub fn run_feet(
         })
         .collect::<Result<_, StudyError>>()?;
     let study = (shard == Shard::WHOLE).then(|| assemble_feet(spec, &points));
+    if let (Some(path), true) = (points_file, shard == Shard::WHOLE) {
+        finish_points(path, &spec.header(), &points)?;
+    }
     Ok(FeetRun {
         points,
         simulated: simulated.into_inner(),

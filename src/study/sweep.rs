@@ -277,6 +277,19 @@ pub fn write_points<R: SweepPoint>(
     std::fs::rename(&tmp, path).map_err(|e| StudyError::io(path, e))
 }
 
+/// At the end of a complete (unsharded) run: rewrites its points file in canonical order
+/// (by key), the order [`merge`]'s callers write, so one run's file and merged shards'
+/// file are the same bytes.
+pub fn finish_points<R: SweepPoint>(
+    path: &Path,
+    header: &str,
+    points: &[R],
+) -> Result<(), StudyError> {
+    let mut sorted = points.to_vec();
+    sorted.sort_by_key(|p| p.key());
+    write_points(path, header, &sorted)
+}
+
 /// Joins points files of one study (same first line): rows keyed alike must agree
 /// exactly. Returns the specification line and the union of the rows (unordered: the
 /// study sorts them).

@@ -26,7 +26,7 @@ use sha2::{Digest, Sha256};
 use super::StudyError;
 use super::min_torque::{MinTorqueOptions, min_torque};
 use super::scaling::{StudyLaw, law};
-use super::sweep::{PointLog, Shard, SweepPoint, append_to, open_log, spec_line};
+use super::sweep::{PointLog, Shard, SweepPoint, append_to, finish_points, open_log, spec_line};
 use crate::sim::{
     ContactScaling, Design, GRAVITY_MPS2, MassLaw, WalkOptions, WalkReport, simulate_walk,
 };
@@ -238,17 +238,8 @@ pub struct MeanSd {
 }
 
 fn mean_sd(v: &[f64]) -> Option<MeanSd> {
-    if v.is_empty() {
-        return None;
-    }
-    let n = v.len() as f64;
-    let mean = v.iter().sum::<f64>() / n;
-    let sd = if v.len() > 1 {
-        (v.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / (n - 1.0)).sqrt()
-    } else {
-        0.0
-    };
-    Some(MeanSd { mean, sd })
+    let (mean, sd) = crate::sim::walk::mean_sd(v);
+    (!v.is_empty()).then_some(MeanSd { mean, sd })
 }
 
 /// One row of Table III: a design under a mass law and a contact rule.
@@ -357,6 +348,9 @@ pub fn run_table3(
     } else {
         None
     };
+    if let (Some(path), true) = (points_file, shard == Shard::WHOLE) {
+        finish_points(path, &spec.header(), &points)?;
+    }
     Ok(Table3Run {
         points,
         simulated: simulated.into_inner(),
@@ -464,21 +458,6 @@ pub fn table3_point(
         yaw_pp_deg: f(|g| g.yaw_pp_deg),
         peak_torque_nm: f(|g| g.peak_torque_nm),
     })
-}
-
-/// Orders points canonically (chain order of `spec`, then leg length).
-pub fn sort_points(spec: &Table3Spec, points: &mut [Table3Point]) {
-    let rank: HashMap<(String, MassLaw, ContactScaling), usize> = spec
-        .chains()
-        .into_iter()
-        .enumerate()
-        .map(|(k, (d, m, c))| ((spec.designs[d].name.clone(), m, c), k))
-        .collect();
-    points.sort_by(|a, b| {
-        let ra = rank.get(&(a.design.clone(), a.mass_law, a.contact));
-        let rb = rank.get(&(b.design.clone(), b.mass_law, b.contact));
-        ra.cmp(&rb).then(a.leg_length_m.total_cmp(&b.leg_length_m))
-    });
 }
 
 /// Fits and summaries over a complete set of points.

@@ -115,16 +115,6 @@ pub fn interpolate_min_torque(points: &[Table3Point], leg_length_m: f64) -> Opti
     interpolate(points, leg_length_m, |p| p.min_torque_nm)
 }
 
-/// The same for the bracket's ends: (failing, walking) torque at `leg_length_m`.
-pub fn interpolate_bracket(points: &[Table3Point], leg_length_m: f64) -> Option<[f64; 2]> {
-    Some([
-        interpolate(points, leg_length_m, |p| {
-            p.bracket_lo_nm.filter(|v| *v > 0.0)
-        })?,
-        interpolate(points, leg_length_m, |p| p.bracket_hi_nm)?,
-    ])
-}
-
 /// Log–log interpolation of a column over the walking points (exact at a point; None
 /// outside them).
 pub(crate) fn interpolate(

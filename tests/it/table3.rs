@@ -6,7 +6,7 @@ use std::path::PathBuf;
 use std::sync::OnceLock;
 
 use robot_survey::sim::{ContactScaling, Design, MassLaw};
-use robot_survey::study::sweep::{self, Shard, SweepPoint};
+use robot_survey::study::sweep::{self, Shard};
 use robot_survey::study::table3::{Table3Point, table3_leg_lengths};
 use robot_survey::study::{Table3Spec, run_table3};
 
@@ -39,10 +39,6 @@ fn whole() -> &'static (PathBuf, Vec<u8>, robot_survey::study::Table3) {
     WHOLE.get_or_init(|| {
         let path = tmp("whole.csv");
         let run = run_table3(&spec(), Shard::WHOLE, Some(&path), &()).expect("table3 runs");
-        // What the CLI does at the end of a complete run: canonical order.
-        let mut pts = run.points.clone();
-        pts.sort_by_key(|p| p.key());
-        sweep::write_points(&path, &spec().header(), &pts).expect("rewrite");
         let bytes = std::fs::read(&path).expect("points file");
         (path, bytes, run.table.expect("a whole run makes the table"))
     })
