@@ -72,11 +72,9 @@ fn fmt_check_reports_a_non_canonical_record_and_exits_1_without_writing() {
     let dir = common::dataset_copy();
     let f = dir.path().join("robots/cassie.toml");
     let text = std::fs::read_to_string(&f).expect("cassie");
-    // Same data, values out of canonical order and with an integer-looking float.
-    let messy = text.replace(
-        "leg_length_m = { value = 1.0,",
-        "leg_length_m = { value = 1,",
-    );
+    // Same data with an integer-looking float, which the canonical form writes as 31.0.
+    let messy = text.replace("mass_kg = { value = 31.0,", "mass_kg = { value = 31,");
+    assert_ne!(messy, text, "the test's edit must change cassie.toml");
     std::fs::write(&f, &messy).expect("write");
     let d = dir.path().display().to_string();
     let out = common::survey(&["dataset", "fmt", "--check", "--dataset", &d]);
