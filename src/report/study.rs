@@ -6,6 +6,7 @@ use super::plot::{Panel, Series};
 use super::sig;
 use crate::sim::{ContactScaling, MassLaw};
 use crate::study::paper::PaperTable3;
+use crate::study::scaling::StudyLaw;
 use crate::study::{Table3, Table3Row};
 
 fn law_name(m: MassLaw) -> &'static str {
@@ -201,6 +202,29 @@ fn series_key(r: &Table3Row, several_contacts: bool) -> String {
     }
 }
 
+/// One chain's points with its fitted law, labelled with the law's exponent.
+fn chain_series(
+    r: &Table3Row,
+    several_contacts: bool,
+    k: usize,
+    (symbol, exponent): (&str, Option<f64>),
+    law: Option<&StudyLaw>,
+    points: Vec<(f64, f64)>,
+) -> Series {
+    Series {
+        label: format!(
+            "{} ({symbol} = {})",
+            series_key(r, several_contacts),
+            opt(exponent, 3)
+        ),
+        color: COLORS[k % COLORS.len()],
+        points,
+        line: law.map(|l| (l.a, l.b)),
+        line_range: None,
+        band: Vec::new(),
+    }
+}
+
 fn several_contacts(t: &Table3) -> bool {
     t.rows.iter().any(|r| r.contact != t.rows[0].contact)
 }
@@ -223,18 +247,14 @@ pub fn table3_velocity_panels(t: &Table3) -> Vec<Panel> {
                     .filter(|(_, v)| *v > 0.0)
                     .collect();
                 all.extend(&pts);
-                series.push(Series {
-                    label: format!(
-                        "{} (a = {})",
-                        series_key(r, several),
-                        opt(r.velocity_exponent, 3)
-                    ),
-                    color: COLORS[k % COLORS.len()],
-                    points: pts,
-                    line: r.velocity_law.as_ref().map(|l| (l.a, l.b)),
-                    line_range: None,
-                    band: Vec::new(),
-                });
+                series.push(chain_series(
+                    r,
+                    several,
+                    k,
+                    ("a", r.velocity_exponent),
+                    r.velocity_law.as_ref(),
+                    pts,
+                ));
             }
             if let Some(c) = froude_constant(&all) {
                 series.push(reference_line(
@@ -308,18 +328,14 @@ pub fn table3_torque_panels(t: &Table3) -> Vec<Panel> {
                         &t.leg_lengths_m,
                     ));
                 }
-                series.push(Series {
-                    label: format!(
-                        "{} (b = {})",
-                        series_key(r, several),
-                        opt(r.torque_exponent, 3)
-                    ),
-                    color: COLORS[k % COLORS.len()],
-                    points: pts,
-                    line: r.torque_law.as_ref().map(|l| (l.a, l.b)),
-                    line_range: None,
-                    band: Vec::new(),
-                });
+                series.push(chain_series(
+                    r,
+                    several,
+                    k,
+                    ("b", r.torque_exponent),
+                    r.torque_law.as_ref(),
+                    pts,
+                ));
             }
             series.extend(refs);
             Panel {
