@@ -24,6 +24,9 @@ def load_cases(path) -> dict:
 def case_model(case: dict):
     d = dz.load_toml(case["design"])
     d = dz.apply_overrides(d, case.get("overrides", {}), case.get("remove", []))
+    if case.get("effects"):
+        # [[effects]] of the case (tests/golden/drake/gap/effect_cases.toml), SI, unscaled.
+        d["effects"] = list(d.get("effects", [])) + [dict(e) for e in case["effects"]]
     drive = case.get("drive", "design")
     actuated = True
     if drive == "hold":
@@ -42,7 +45,8 @@ def case_model(case: dict):
 def static_sinkage(model: dz.Model) -> float:
     """Closed-form depth at which the two upright feet share m|g_z| equally."""
     load = model.total_mass_kg * abs(model.gravity_mps2[2]) / 2.0
-    return dz.solve_sinkage(model.modulus_pa, model.legs[0].foot_semi_axes_m, load)
+    e = model.contact_modulus_pa if model.contact_modulus_pa is not None else model.modulus_pa
+    return dz.solve_sinkage(e, model.legs[0].foot_semi_axes_m, load)
 
 
 def initial_state(model: dz.Model, init: dict):
@@ -58,9 +62,19 @@ def initial_state(model: dz.Model, init: dict):
         z -= static_sinkage(model)
     elif placement != "touch":
         raise dz.DesignError(f"unknown placement {placement!r}")
-    return (np.array([0.0, 0.0, z]), R,
-            np.array(init.get("linear_velocity_mps", [0, 0, 0]), dtype=float),
-            np.array(init.get("angular_velocity_rad_s", [0, 0, 0]), dtype=float))
+    v = np.array(init.get("linear_velocity_mps", [0, 0, 0]), dtype=float)
+    w = np.array(init.get("angular_velocity_rad_s", [0, 0, 0]), dtype=float)
+    qd0 = float(init.get("hip_rate_rad_s", 0.0))
+    if qd0 != 0.0:
+        # An internal impulse at the hip of the legs at rest: zero linear and angular momentum,
+        # ν0 = M⁻¹ e_q q̇0/(M⁻¹)_qq (upright, q = 0: world = leg axes).
+        if roll or pitch or yaw or v.any() or w.any():
+            raise dz.DesignError("hip_rate_rad_s: for upright starts at rest only")
+        _, M = effective_hip_inertia(model)
+        col = np.linalg.solve(M, np.eye(7)[:, 6])
+        nu = col * qd0 / col[6]
+        v, w = nu[0:3], nu[3:6]
+    return np.array([0.0, 0.0, z]), R, v, w, qd0
 
 
 def run_trace(model, actuated, init, duration_s, hint_over_l=0.06, time_step_s=None,
@@ -68,8 +82,8 @@ def run_trace(model, actuated, init, duration_s, hint_over_l=0.06, time_step_s=N
     """Runs a case and records every step."""
     w = DrakeWalker(model, resolution_hint_over_l=hint_over_l, actuated=actuated,
                     time_step_s=time_step_s, servo=servo, approximation=approximation)
-    p0, R0, v0, w0 = initial_state(model, init)
-    w.set_state(p0, R0, hip_velocity_mps=v0, omega_left_body=w0)
+    p0, R0, v0, w0, qd0 = initial_state(model, init)
+    w.set_state(p0, R0, hip_velocity_mps=v0, omega_left_body=w0, hip_rate=qd0)
     plant, pc = w.plant, w.plant_context
     dt = w.time_step_s
     n = int(round(duration_s / dt))

@@ -8,11 +8,16 @@ Bodies, joints and contact geometry follow `src/sim/model.rs`:
 * each leg's foot: a compliant hydroelastic Ellipsoid (modulus E, mesh resolution hint
   `resolution_hint_over_l`·L) centred at the design's foot centre in the leg frame;
 * ground: rigid hydroelastic HalfSpace z ≤ 0 on the world body; a slope is modelled as in
-  the project by tilting gravity (the ground stays z = 0).
+  the project by tilting gravity (the ground stays z = 0). With the `soft_ground` effect:
+  a compliant hydroelastic Box slab instead (top face z = 0, thickness 2·R_z, modulus E_g;
+  Drake refuses a compliant HalfSpace against a compliant foot), see `ground_slab`.
 The hip actuator and the hardstop are one LeafSystem (`HipController`) writing the
 plant's applied generalized force input: explicit, i.e. held over each time step at its
 value from the state at the start of the step (Drake's discrete plant samples its inputs
 at the start of the step). Drake's joint limits are NOT used.
+Effects: `hip_viscous_damping` is the RevoluteJoint's own damping (implicit in Drake's
+discrete solver); `hip_coulomb_friction` is added by `HipController` (explicit, like the
+hardstop); `friction_coefficient` sets μ on both geometries; `soft_ground` as above.
 """
 
 from __future__ import annotations
@@ -25,6 +30,7 @@ from pydrake.geometry import (
     AddCompliantHydroelasticProperties,
     AddContactMaterial,
     AddRigidHydroelasticProperties,
+    Box,
     CollisionFilterDeclaration,
     Ellipsoid,
     GeometrySet,
@@ -46,7 +52,25 @@ from pydrake.multibody.tree import (
 from pydrake.systems.analysis import Simulator
 from pydrake.systems.framework import DiagramBuilder, LeafSystem
 
-from design import Model, controller_torque, hardstop_torque
+from design import Model, controller_torque, hardstop_torque, hip_coulomb_torque
+
+# Lateral half-size of the soft-ground slab, in leg lengths (the walks travel < 30 L).
+GROUND_SLAB_HALF_SIZE_OVER_L = 200.0
+
+
+def ground_slab(model: Model):
+    """(thickness, lateral half-size) [m] of the compliant ground slab for `soft_ground`.
+
+    Drake gives a compliant Box the pressure field p = E_g·d/d_max (d = distance to the
+    box's boundary, d_max = half its smallest dimension), so near the middle of the top face
+    it is the field of a compliant half space with slab thickness h = d_max: gradient E_g/h.
+    Two compliant fields meet where their pressures are equal, and to first order in the
+    penetration the pressure of the pair is δ·g_foot·g_ground/(g_foot + g_ground). The foot's
+    field p = E(1 − r) has gradient E/R_z at its lowest point, so h = R_z gives
+    δ·(E/R_z)·(E_g/R_z)/((E + E_g)/R_z) = δ·E_eff/R_z with E_eff = E·E_g/(E + E_g): the foot
+    pressed into a rigid floor with the project's series modulus. Thickness 2·R_z."""
+    rz = max(leg.foot_semi_axes_m[2] for leg in model.legs)
+    return 2.0 * rz, GROUND_SLAB_HALF_SIZE_OVER_L * model.leg_length_m
 
 
 class _QuietHalfSpaceWarning(logging.Filter):
@@ -70,6 +94,7 @@ class HipController(LeafSystem):
         # With the servo inside the plant (SAP PD actuator) only the hardstop is applied here.
         self._servo_in_plant = servo_in_plant
         self._hs = model.hardstop
+        self._coulomb = list(model.hip_coulomb)
         self._nv = plant.num_velocities()
         self._iq = hip_joint.position_start()
         self._iv = plant.num_positions() + hip_joint.velocity_start()
@@ -78,6 +103,7 @@ class HipController(LeafSystem):
         self.DeclareVectorOutputPort("generalized_force", self._nv, self._calc)
         # (t, q, q̇, actuator torque, hardstop torque) of the last evaluation.
         self.last = (math.nan, math.nan, math.nan, 0.0, 0.0)
+        self.last_coulomb = 0.0
 
     def _calc(self, context, output):
         x = self.get_input_port(0).Eval(context)
@@ -85,10 +111,12 @@ class HipController(LeafSystem):
         q, qd = float(x[self._iq]), float(x[self._iv])
         tau = 0.0 if self._servo_in_plant else controller_torque(self._ctl, t, q, qd)
         hs = hardstop_torque(self._hs, q, qd)
+        fr = hip_coulomb_torque(self._coulomb, qd) if self._coulomb else 0.0
         out = np.zeros(self._nv)
-        out[self._jv] = tau + hs
+        out[self._jv] = tau + hs + fr
         output.SetFromVector(out)
         self.last = (t, q, qd, tau, hs)
+        self.last_coulomb = fr
 
 
 class ServoReference(LeafSystem):
@@ -162,8 +190,11 @@ class DrakeWalker:
         self.left, self.right = bodies
         self.floating = plant.AddJoint(QuaternionFloatingJoint(
             "left_floating", plant.world_frame(), self.left.body_frame()))
+        # hip_viscous_damping: Drake's joint damping τ = −c·q̇ (implicit in the discrete
+        # solver: it enters the linearised dynamics matrix as dt·c).
         self.hip = plant.AddJoint(RevoluteJoint(
-            "hip", self.left.body_frame(), self.right.body_frame(), [0.0, 1.0, 0.0]))
+            "hip", self.left.body_frame(), self.right.body_frame(), [0.0, 1.0, 0.0],
+            float(model.hip_damping_nms_per_rad)))
 
         mu = model.friction_mu
         friction = CoulombFriction(mu, mu)
@@ -183,13 +214,29 @@ class DrakeWalker:
                     body.name() + "_foot", props)
                 self.foot_ids.append(gid)
             ground = ProximityProperties()
-            AddRigidHydroelasticProperties(ground)
-            # Drake adds the two geometries' relaxation times; the rigid ground adds 0.
-            # Its Hunt-Crossley d is not used (the compliant foot's d is, for a rigid partner).
-            AddContactMaterial(dissipation=0.0, friction=friction, properties=ground)
+            if model.ground_modulus_pa is None:
+                AddRigidHydroelasticProperties(ground)
+                shape, X_ground = HalfSpace(), RigidTransform()
+                # Its Hunt-Crossley d is not used (the compliant foot's d is, for a rigid
+                # partner).
+                ground_d = 0.0
+            else:
+                # soft_ground: compliant slab, top face at z = 0 (see ground_slab). The
+                # resolution hint is ignored for a Box (Drake's medial-axis box mesh, on which
+                # the linear field is exact).
+                thick, half = ground_slab(model)
+                AddCompliantHydroelasticProperties(thick, model.ground_modulus_pa, ground)
+                shape = Box(2.0 * half, 2.0 * half, thick)
+                X_ground = RigidTransform([0.0, 0.0, -0.5 * thick])
+                # Drake weights two compliant geometries' Hunt-Crossley d by their
+                # stiffnesses; the same d on both keeps the design's d (the project's
+                # soft_ground changes the modulus only).
+                ground_d = model.hunt_crossley_s_per_m if model.hunt_crossley_s_per_m is not None else 0.0
+            # Drake adds the two geometries' relaxation times; the ground adds 0.
+            AddContactMaterial(dissipation=ground_d, friction=friction, properties=ground)
             ground.AddProperty("material", "relaxation_time", 0.0)
             self.ground_id = plant.RegisterCollisionGeometry(
-                plant.world_body(), RigidTransform(), HalfSpace(), "ground", ground)
+                plant.world_body(), X_ground, shape, "ground", ground)
         self.actuator = None
         if servo == "sap_pd":
             from pydrake.multibody.tree import PdControllerGains

@@ -3,7 +3,11 @@
 
 Subcommands (run from the repository root; paths are relative to it):
   walk DESIGN.toml [options]   one walk -> trajectory CSV (project format) + metrics JSON
+  trials CONDITIONS.csv --out TRIALS.csv [--effect ...] [--jobs N]
+                               one 16-cycle walk per trial condition -> trials CSV
+                               (project format, dataset/trials/README.md)
   case NAME [--out FILE]       one elementary case of tests/golden/drake/cases.toml
+  effect-cases [--out FILE]    the effect checks of tests/golden/drake/gap/effect_cases.toml
   cases [--out FILE]           all elementary cases -> elementary.json
   all --out tests/golden/drake/  regenerate every golden file
 
@@ -26,9 +30,14 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 import numpy as np  # noqa: E402
 
 import design as dz  # noqa: E402
+import drake_model as dm  # noqa: E402
 import walk as wk  # noqa: E402
 
 REPO = dz.REPO_ROOT
+EFFECT_HELP = ("add a physical effect (repeatable): NAME=VALUE sets its magnitude (first "
+               "parameter), NAME.PARAM=VALUE one parameter; SI at the design's 1x size, other "
+               "parameters at the default of dataset/effects/NAME.toml. Supported: "
+               + ", ".join(dz.SUPPORTED_EFFECTS))
 DEFAULT_HINT_OVER_L = 0.06
 MAX_SAMPLES_PER_CYCLE = 50
 
@@ -86,8 +95,15 @@ def engine_settings(model: dz.Model, hint_over_l: float, time_step_s: float,
         "contact_model": "hydroelastic",
         "contact_surface_representation": "polygon",
         "foot_geometry": "compliant hydroelastic Ellipsoid (tetrahedral mesh, linear pressure p = E(1 - r))",
-        "ground_geometry": "rigid hydroelastic HalfSpace z <= 0 (slope: gravity tilted, as in the project)",
+        "ground_geometry": (
+            "rigid hydroelastic HalfSpace z <= 0 (slope: gravity tilted, as in the project)"
+            if model.ground_modulus_pa is None else
+            "soft_ground: compliant hydroelastic Box slab, top face z = 0, thickness %.6g m "
+            "(2 R_z: field gradient E_g/R_z at the top face), lateral half-size %.6g m, "
+            "E_g = %.6g Pa (slope: gravity tilted)" % (*dm.ground_slab(model), model.ground_modulus_pa)),
         "hydroelastic_modulus_pa": model.modulus_pa,
+        "ground_hydroelastic_modulus_pa": model.ground_modulus_pa,
+        "contact_modulus_series_pa": model.contact_modulus_pa,
         "mesh_resolution_hint_over_l": hint_over_l,
         "mesh_resolution_hint_m": hint_over_l * model.leg_length_m,
         "relaxation_time_s": model.relaxation_time_s if kv else None,
@@ -108,22 +124,70 @@ def engine_settings(model: dz.Model, hint_over_l: float, time_step_s: float,
             else "Drake PD-controlled JointActuator (implicit in SAP), effort limit = torque limit; "
                  "desired state [A sin wt, A w cos wt] at the start of the step"),
         "hardstop": "same LeafSystem, one-sided spring-damper (model.rs law); Drake joint limits not used",
+        "effects": model.effects,
+        "effects_in_drake": effects_in_drake(model),
         "normal_force_per_foot": "|z component| of the hydroelastic contact force on the foot "
                                  "(ContactResults, sampled output port = the last step's solve)",
     }
 
 
+def effects_in_drake(model: dz.Model) -> dict:
+    """How each effect of `model` is realised in the Drake plant (for the JSON)."""
+    out = {}
+    names = {e["effect"] for e in model.effects}
+    if "hip_viscous_damping" in names:
+        out["hip_viscous_damping"] = (
+            f"RevoluteJoint damping c = {model.hip_damping_nms_per_rad:.9g} N m s/rad "
+            "(Drake's joint damping, implicit in the discrete solver)")
+    if "hip_coulomb_friction" in names:
+        out["hip_coulomb_friction"] = (
+            "-tau_f qdot/sqrt(qdot^2 + w_s^2) added by the controller LeafSystem to the applied "
+            "generalized force (explicit: from the state at the start of the step), "
+            "[tau_f, w_s] = " + str([list(x) for x in model.hip_coulomb]))
+    if "soft_ground" in names:
+        out["soft_ground"] = (
+            f"compliant ground slab E_g = {model.ground_modulus_pa:.9g} Pa, thickness 2 R_z; "
+            "Drake combines the foot's and the ground's pressure fields in series by their "
+            f"gradients: first-order contact modulus {model.contact_modulus_pa:.9g} Pa "
+            "= E_foot E_g/(E_foot + E_g)")
+    if "friction_coefficient" in names:
+        out["friction_coefficient"] = (
+            f"mu_static = mu_dynamic = {model.friction_mu:.9g} on the foot and on the ground "
+            "(Drake's combination 2 mu1 mu2/(mu1 + mu2) = mu)")
+    return out
+
+
 # --------------------------------------------------------------------------------- walk
 def prepare_design(design_path, leg_length=None, mass_law="l2", contact_scaling="similar",
-                   frequency=None, relaxation_scale=1.0, overrides=None):
+                   frequency=None, relaxation_scale=1.0, overrides=None, effects=None,
+                   amplitude_deg=None, slope_deg=None, mass_kg=None, torque_nm=None):
+    """The design as `src/gap/simulate.rs` `Condition::design_with` builds it: read (and
+    dotted-key overrides), `effects` added (settings [(name, nondimensional)] of
+    `dz.parse_effect_args`, evaluated for the 1× design), amplitude and slope set, scaled
+    to `leg_length` (effects by their rule), then mass, frequency and torque (servo limit or
+    bang-bang magnitude) set at the scaled size."""
     d = dz.load_toml(design_path)
     if overrides:
         d = dz.apply_overrides(d, overrides)
     dz.check_supported(d)
+    if effects:
+        d["effects"] = list(d.get("effects", [])) + [
+            dz.effect_spec(d, name, nd, origin=f"effect {name}") for name, nd in effects]
+    if amplitude_deg is not None:
+        if d["control"]["kind"] != "servo_sine":
+            raise dz.DesignError("amplitude_deg given, but the design is not a position servo")
+        d["control"]["amplitude_deg"] = amplitude_deg
+    if slope_deg is not None:
+        d.setdefault("ground", {})["slope_deg"] = slope_deg
     L = leg_length if leg_length is not None else d["geometry"]["leg_length_m"]
     d = dz.scaled(d, L, mass_law, contact_scaling)
+    if mass_kg is not None:
+        d["mass"]["total_mass_kg"] = mass_kg
     if frequency is not None:
         d["control"]["frequency_hz"] = frequency
+    if torque_nm is not None:
+        key = "torque_limit_nm" if d["control"]["kind"] == "servo_sine" else "torque_nm"
+        d["control"][key] = torque_nm
     if relaxation_scale != 1.0:
         if "relaxation_time_s" not in d["contact"]:
             raise dz.DesignError("--relaxation-scale needs a relaxation_time_s design")
@@ -140,9 +204,14 @@ def do_walk(design_path, *, leg_length=None, mass_law="l2", contact_scaling="sim
             frequency=None, duration=25.0, hint_over_l=DEFAULT_HINT_OVER_L,
             relaxation_scale=1.0, time_step_scale=1.0, trajectory=None, json_out=None,
             decimation="auto", command=None, quiet=False, servo="auto",
-            initial_roll_deg=None, approximation=None):
+            initial_roll_deg=None, approximation=None, effects=None):
+    """effects: `--effect` arguments (strings), in SI at the design's 1× size."""
+    settings = None
+    if effects:
+        base = dz.load_toml(design_path)
+        settings = dz.parse_effect_args(base, effects)
     d = prepare_design(design_path, leg_length, mass_law, contact_scaling, frequency,
-                       relaxation_scale)
+                       relaxation_scale, effects=settings)
     model = dz.build_model(d)
     dt = model.time_step_s * time_step_scale
     freq = model.controller["frequency_hz"]
@@ -172,7 +241,8 @@ def do_walk(design_path, *, leg_length=None, mass_law="l2", contact_scaling="sim
                     "contact_scaling": contact_scaling, "frequency_hz": freq,
                     "duration_s": duration, "relaxation_scale": relaxation_scale,
                     "time_step_scale": time_step_scale, "servo": run["walker"].servo,
-                    "initial_roll_deg": model.initial_roll_deg if initial_roll_deg is None else initial_roll_deg},
+                    "initial_roll_deg": model.initial_roll_deg if initial_roll_deg is None else initial_roll_deg,
+                    "effect_args": list(effects or [])},
         "scaled_design": d,
         "engine": engine_settings(model, hint_over_l, dt, run["walker"].servo,
                                   run["walker"].approximation),
@@ -232,15 +302,30 @@ def main(argv=None):
                    help="Drake's discrete contact approximation (default: sap for a relaxation-time "
                         "design, similar for a Hunt-Crossley one). sap and similar are convex "
                         "(a sliding contact separates); lagged is not")
+    w.add_argument("--effect", action="append", default=[], metavar="NAME[.PARAM]=VALUE",
+                   help=EFFECT_HELP)
     w.add_argument("--trajectory", help="output CSV")
     w.add_argument("--decimate", default="auto",
                    help="keep every N-th sample in the CSV ('auto': <= 50 per drive cycle)")
     w.add_argument("--json", help="output JSON (metrics, settings, timing)")
+    t = sub.add_parser("trials", help="one walk per trial condition -> trials CSV")
+    t.add_argument("conditions", help="trials CSV (dataset/trials/README.md); only the "
+                                      "condition columns are used")
+    t.add_argument("--effect", action="append", default=[], metavar="NAME[.PARAM]=VALUE",
+                   help=EFFECT_HELP + " Values refer to the first row's design at 1x "
+                        "(like survey gap synth --design) and apply to every row in scale units.")
+    t.add_argument("--out", required=True, help="output trials CSV")
+    t.add_argument("--jobs", type=int, default=2, help="parallel processes (default 2); "
+                                                       "does not change the output")
     c = sub.add_parser("case", help="run one elementary case")
     c.add_argument("name")
     c.add_argument("--cases", default="tests/golden/drake/cases.toml")
     c.add_argument("--resolution-hint-over-l", type=float, default=DEFAULT_HINT_OVER_L)
     c.add_argument("--out", help="output JSON")
+    ec = sub.add_parser("effect-cases", help="run the effect checks (Drake vs analytic)")
+    ec.add_argument("--cases", default="tests/golden/drake/gap/effect_cases.toml")
+    ec.add_argument("--only", nargs="*", help="case names (default: all, plus the mesh variant)")
+    ec.add_argument("--out", default="tests/golden/drake/gap/effect_cases.json")
     cs = sub.add_parser("cases", help="run all elementary cases")
     cs.add_argument("--cases", default="tests/golden/drake/cases.toml")
     cs.add_argument("--out", default="tests/golden/drake/elementary.json")
@@ -251,6 +336,9 @@ def main(argv=None):
     args = ap.parse_args(argv)
     command = "python tools/drake/harness.py " + " ".join(argv if argv is not None else sys.argv[1:])
 
+    if args.cmd == "trials":
+        import trials as tz
+        return tz.run_trials(args.conditions, args.out, args.effect, jobs=args.jobs)
     if args.cmd == "walk":
         do_walk(args.design, leg_length=args.leg_length, mass_law=args.mass_law,
                 contact_scaling=args.contact_scaling, frequency=args.frequency,
@@ -258,7 +346,7 @@ def main(argv=None):
                 relaxation_scale=args.relaxation_scale, time_step_scale=args.time_step_scale,
                 trajectory=args.trajectory, json_out=args.json, decimation=args.decimate,
                 command=command, servo=args.servo, initial_roll_deg=args.initial_roll_deg,
-                approximation=args.approximation)
+                approximation=args.approximation, effects=args.effect)
     elif args.cmd == "case":
         import cases as cz
         res = cz.run_case_by_name(args.name, args.cases, hint_over_l=args.resolution_hint_over_l)
@@ -267,6 +355,26 @@ def main(argv=None):
             write_json(res, args.out)
         print(json.dumps(clean(res["measured"]), indent=1))
         print(json.dumps(clean(res["analytic"]), indent=1))
+    elif args.cmd == "effect-cases":
+        import effect_cases as ez
+        t0 = time.perf_counter()
+        if args.only:
+            allc = dz.load_toml(args.cases)["cases"]
+            res = {"cases": {n: ez.run_case(n, allc[n]) for n in args.only}}
+        else:
+            res = ez.run_all(args.cases)
+        res = {"drake_version": drake_version(), "command": command,
+               "cases_file": rel(args.cases), "units": "SI (m, s, N, kg, rad/s) unless the key says deg",
+               "relative_difference": "(measured - analytic)/|analytic|",
+               "wall_s": time.perf_counter() - t0, **res}
+        write_json(res, args.out)
+        for n, r in res["cases"].items():
+            for k, c in r["comparison"].items():
+                print(f"{n}: {k} Drake {c['measured']:.6g}")
+                for a, x in c["analytic"].items():
+                    rd = x["relative_difference"]
+                    print(f"    {a:56s} {x['value']:.6g}  "
+                          + (f"{100 * rd:+.3f} %" if rd is not None else ""))
     elif args.cmd == "cases":
         import cases as cz
         res = cz.run_all_cases(args.cases)
