@@ -11,8 +11,10 @@
 //! - [`predict`], [`inference`], [`laws`]: designer predictions, hypothesis tests, Table 1.
 //! - [`motors`]: the motor catalogue (scaling laws, actuator datasheets, anchors) and its validation.
 //! - [`diff`]: the live records against a frozen release, for a pull request's reviewer.
+//! - [`checkpoint`]: points files of long runs: resume after an interruption, shards, merge.
 //! - [`report`]: output formats (md, tex, csv, json) and figures.
 
+pub mod checkpoint;
 pub mod crosscheck;
 pub mod dataset;
 pub mod diff;

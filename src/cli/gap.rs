@@ -66,6 +66,11 @@ pub struct SynthArgs {
     /// parameter; repeat for several. None: the null case.
     #[arg(long = "effect", value_name = "NAME=VALUE")]
     pub effects: Vec<String>,
+    /// PATH=VALUE: the robot differs from its design file here (a dotted path of the design
+    /// TOML at 1×, e.g. mass.leg_com_height_over_l=0.52): trials of a robot whose nominal
+    /// parameters are wrong. Repeat for several.
+    #[arg(long = "set", value_name = "PATH=VALUE")]
+    pub set: Vec<String>,
     /// Relative sd of the Gaussian measurement noise (written into the _sd columns).
     #[arg(long, default_value_t = 0.05)]
     pub noise: f64,
@@ -90,7 +95,7 @@ pub struct DiagnoseArgs {
     #[arg(long, value_delimiter = ',')]
     pub effects: Vec<String>,
     /// Magnitudes simulated per candidate across its plausible range.
-    #[arg(long, default_value_t = 8)]
+    #[arg(long, default_value_t = 9)]
     pub grid: usize,
     /// Relative sd assumed where a measurement states none.
     #[arg(long, default_value_t = 0.10)]
@@ -98,6 +103,10 @@ pub struct DiagnoseArgs {
     /// Family-wise false-alarm rate of the effect tests.
     #[arg(long, default_value_t = 0.001)]
     pub alpha: f64,
+    /// Take the design's nominal parameters as right: do not calibrate its [[uncertain]]
+    /// values (only effects are candidates).
+    #[arg(long)]
+    pub no_calibration: bool,
     #[arg(long, value_enum, default_value_t)]
     pub format: GapFormat,
     /// Figure of the standardised residuals per condition, before and after (SVG or PNG).
@@ -106,24 +115,45 @@ pub struct DiagnoseArgs {
 }
 
 #[derive(Args, Debug)]
+#[command(after_help = "Examples:\n  \
+survey gap benchmark --drake tests/golden/drake/gap --points bench.csv --out reports/\n  \
+survey gap benchmark --drake tests/golden/drake/gap --points b-2.csv --shard 2/4   # one slice\n  \
+survey gap benchmark --drake tests/golden/drake/gap --merge b-1.csv b-2.csv b-3.csv b-4.csv --points bench.csv --out reports/\n  \
+survey gap benchmark --quick --out /tmp/bench          # a small run (minutes)\n\n\
+Suites: main (the design's default conditions: nulls, single effects, pairs, nominal-parameter \
+errors), one-robot (one size, conditions varied by drive, amplitude, payload, slope), drake \
+(trials made by Drake with effects added in Drake). Every finished case is appended to the \
+points file at once: a re-run resumes, shards merge into what one run writes.")]
 pub struct BenchmarkArgs {
     #[arg(long, default_value = "mugatu")]
     pub design: String,
-    /// Noise seeds per (effect, magnitude, noise level).
-    #[arg(long, default_value_t = 3)]
-    pub seeds: u64,
-    /// Null cases (no effect) per noise level: the false-alarm rate.
-    #[arg(long, default_value_t = 10)]
-    pub null_seeds: u64,
-    /// Noise levels (relative sd).
-    #[arg(long, value_delimiter = ',', default_values_t = vec![0.01, 0.05, 0.10])]
-    pub noise: Vec<f64>,
-    /// Magnitudes as multiples of each effect's identification threshold at 5 % noise.
-    #[arg(long, value_delimiter = ',', default_values_t = vec![1.0, 2.0, 4.0])]
-    pub multiples: Vec<f64>,
+    /// A small run: 20 nulls per noise level, 1 seed, noise 5 % only, no one-robot suite.
+    #[arg(long)]
+    pub quick: bool,
+    /// Null cases per noise level (main suite).
+    #[arg(long)]
+    pub null_cases: Option<u64>,
+    /// Noise seeds per non-null case.
+    #[arg(long)]
+    pub seeds: Option<u64>,
+    /// Noise levels (relative sd) of the null and single-effect cases.
+    #[arg(long, value_delimiter = ',')]
+    pub noise: Option<Vec<f64>>,
+    /// Folder of Drake trials files (`trials-*.csv`, e.g. tests/golden/drake/gap).
+    #[arg(long, value_name = "DIR")]
+    pub drake: Option<PathBuf>,
     /// Effects to benchmark (default: all).
     #[arg(long, value_delimiter = ',')]
     pub effects: Vec<String>,
+    /// Points file: every finished case is appended; an existing file is resumed.
+    #[arg(long, value_name = "FILE")]
+    pub points: Option<PathBuf>,
+    /// Run one slice i/n of the cases (needs --points).
+    #[arg(long, value_name = "I/N")]
+    pub shard: Option<robot_survey::checkpoint::Shard>,
+    /// Points files of shards to merge into --points (no cases are run).
+    #[arg(long, num_args = 1.., value_name = "FILE")]
+    pub merge: Vec<PathBuf>,
     /// Folder for gap-benchmark.md, .json and .svg.
     #[arg(long, value_name = "DIR", default_value = "reports")]
     pub out: PathBuf,
@@ -176,9 +206,26 @@ fn synth(a: &SynthArgs) -> anyhow::Result<ExitCode> {
     for e in &a.effects {
         command.push_str(&format!(" --effect {e}"));
     }
+    let mut params = Vec::new();
+    for arg in &a.set {
+        let (path, value) = arg
+            .split_once('=')
+            .ok_or_else(|| anyhow::anyhow!("--set {arg}: expected PATH=VALUE"))?;
+        let value: f64 = value
+            .trim()
+            .parse()
+            .map_err(|_| anyhow::anyhow!("--set {arg}: {value:?} is not a number"))?;
+        // Checked now, naming the argument: the path exists and the value is valid.
+        design
+            .with_value(path.trim(), value)
+            .map_err(|e| anyhow::anyhow!("--set {arg}: {e}"))?;
+        params.push((path.trim().to_string(), value));
+        command.push_str(&format!(" --set {arg}"));
+    }
     let opts = gap::synth::SynthOptions {
         design: a.design.clone(),
         effects,
+        params,
         noise: a.noise,
         seed: a.seed,
     };
@@ -212,6 +259,7 @@ fn diagnose(a: &DiagnoseArgs) -> anyhow::Result<ExitCode> {
         grid_points: a.grid,
         default_relative_sd: a.default_sd,
         alpha: a.alpha,
+        calibrate: !a.no_calibration,
         ..DiagnoseOptions::default()
     };
     let pb = indicatif::ProgressBar::new_spinner();
@@ -227,8 +275,8 @@ fn diagnose(a: &DiagnoseArgs) -> anyhow::Result<ExitCode> {
     })?;
     pb.finish_and_clear();
     eprintln!(
-        "{} walks: nominal {:.1} s, candidate grids {:.1} s, refinement {:.1} s, fitting {:.2} s",
-        timing.walks, timing.nominal_s, timing.grid_s, timing.refine_s, timing.fit_s
+        "{} walks: knob grids {:.1} s, forward selection {:.1} s, explanations and intervals {:.1} s",
+        timing.walks, timing.grid_s, timing.select_s, timing.report_s
     );
     if let Some(p) = &a.plot {
         report::gap::residual_plot(&d, p)?;
@@ -242,29 +290,85 @@ fn diagnose(a: &DiagnoseArgs) -> anyhow::Result<ExitCode> {
 }
 
 fn benchmark(a: &BenchmarkArgs) -> anyhow::Result<ExitCode> {
+    use robot_survey::checkpoint::Shard;
     let lib = EffectLibrary::bundled()?;
-    let opts = gap::benchmark::BenchmarkOptions {
-        design: a.design.clone(),
-        seeds: a.seeds,
-        noise_levels: a.noise.clone(),
-        multiples: a.multiples.clone(),
-        effects: a.effects.clone(),
-        null_seeds: a.null_seeds,
-    };
+    let mut opts = gap::benchmark::BenchmarkOptions::standard(&a.design);
+    if a.quick {
+        opts.null_cases = 20;
+        opts.seeds = 1;
+        opts.noise_levels = vec![0.05];
+        opts.one_robot_null_cases = 0;
+        opts.drake_seeds = 1;
+        opts.calibration_off_noise = None;
+    }
+    if let Some(n) = a.null_cases {
+        opts.null_cases = n;
+    }
+    if let Some(s) = a.seeds {
+        opts.seeds = s;
+    }
+    if let Some(n) = &a.noise {
+        if let Some(bad) = n.iter().find(|x| !(**x > 0.0 && **x < 1.0)) {
+            anyhow::bail!("--noise {bad}: each level must be a fraction in (0, 1)");
+        }
+        opts.noise_levels = n.clone();
+    }
+    opts.drake_dir = a.drake.clone();
+    opts.effects = a.effects.clone();
+    let shard = a.shard.unwrap_or(Shard::WHOLE);
+    if shard != Shard::WHOLE && a.points.is_none() {
+        anyhow::bail!("--shard needs --points FILE (each slice writes its own points file)");
+    }
     let pb = indicatif::ProgressBar::new_spinner();
-    let result = gap::benchmark::run(&lib, &opts, &|what| {
-        pb.set_message(what.to_string());
-        pb.tick();
-    })?;
+    pb.enable_steady_tick(std::time::Duration::from_millis(250));
+    let progress = |what: &str| pb.set_message(what.to_string());
+    progress("planning: thresholds and cases");
+    let plan = gap::benchmark::plan(&lib, &opts, &progress)?;
+    let rows = if a.merge.is_empty() {
+        gap::benchmark::run(&lib, &opts, &plan, a.points.as_deref(), shard, &progress)?
+    } else {
+        let Some(target) = &a.points else {
+            anyhow::bail!("--merge needs --points FILE (the merged file)");
+        };
+        let (header, rows) = robot_survey::checkpoint::merge::<gap::benchmark::CaseRow>(&a.merge)?;
+        if header != gap::benchmark::spec(&opts) {
+            anyhow::bail!(
+                "the merged files were written with other benchmark options than these; merge with the options of the run"
+            );
+        }
+        robot_survey::checkpoint::finish_points(target, &header, &rows)?;
+        let mut rows = rows;
+        rows.sort_by(|x, y| x.key.cmp(&y.key));
+        rows
+    };
     pb.finish_and_clear();
+    if shard != Shard::WHOLE {
+        eprintln!(
+            "shard {shard}: {} cases in {}; merge the shards with --merge to score them",
+            rows.len(),
+            a.points
+                .as_ref()
+                .map(|p| p.display().to_string())
+                .unwrap_or_default()
+        );
+        return Ok(ExitCode::SUCCESS);
+    }
+    let summary = gap::benchmark::summarize(&rows, &lib, &opts, plan.thresholds.clone());
+    let mut command = format!("survey gap benchmark --design {}", a.design);
+    if a.quick {
+        command.push_str(" --quick");
+    }
+    if let Some(d) = &a.drake {
+        command.push_str(&format!(" --drake {}", d.display()));
+    }
     std::fs::create_dir_all(&a.out)?;
-    let md = report::gap::benchmark_md(&result);
+    let md = report::gap::benchmark_md(&summary, &rows, &command);
     write_atomic(&a.out.join("gap-benchmark.md"), md.as_bytes())?;
     write_atomic(
         &a.out.join("gap-benchmark.json"),
-        report::json(&result)?.as_bytes(),
+        report::json(&serde_json::json!({ "summary": summary, "cases": rows }))?.as_bytes(),
     )?;
-    report::gap::confusion_plot(&result, &a.out.join("gap-benchmark.svg"))?;
+    report::gap::confusion_plot(&summary, &a.out.join("gap-benchmark.svg"))?;
     eprintln!("wrote {}/gap-benchmark.{{md,json,svg}}", a.out.display());
     print(&md);
     Ok(ExitCode::SUCCESS)

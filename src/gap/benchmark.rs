@@ -1,389 +1,1420 @@
-//! The diagnosis benchmarked on synthetic trials whose cause is known: every effect at
-//! several magnitudes (multiples of its identification threshold) × noise levels × seeds,
-//! plus null cases. All cases share the default conditions, so the candidates' grid walks
-//! are simulated once and reused through a [`SimCache`].
+//! Benchmark 2.0: the diagnosis on cases whose cause is known, inside and outside what it
+//! assumes.
+//!
+//! Suites (each over one set of conditions, so the knobs' grid walks are shared through a
+//! [`SimCache`]):
+//! * `main`: the design's default conditions (3 sizes × 4 drives). Null cases (no cause)
+//!   per noise level; every library effect alone at multiples of its identification
+//!   threshold; every pair of effects at 2× their thresholds; nominal-parameter errors
+//!   (declared uncertain or not, inside or outside their ranges), an unreported slope, a
+//!   drive amplitude off; the single effects again with calibration off.
+//! * `one-robot`: one size, conditions varied by drive frequency, amplitude, payload and
+//!   slope, as a user with one robot would measure.
+//! * `drake`: trials made by Drake on the reference design (`tests/golden/drake/gap/`),
+//!   with and without an effect added in Drake, plus measurement noise.
+//!
+//! Every case is a row of a points file (resumable, shardable, mergeable like the sweeps);
+//! the scores are computed from the rows ([`summarize`]).
 
-use std::time::Instant;
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
 
-use serde::Serialize;
+use rayon::prelude::*;
+use serde::{Deserialize, Serialize};
 
-use super::diagnose::{DiagnoseOptions, Identifiability, SimCache, diagnose_conditions};
+use super::cache::SimCache;
+use super::diagnose::{DiagnoseOptions, diagnose_conditions};
 use super::error::GapError;
-use super::library::{EffectDef, EffectLibrary, EffectSetting};
-use super::simulate::resolve;
+use super::identify::Identifiability;
+use super::knob::ModelSetting;
+use super::library::{EffectLibrary, EffectSetting};
+use super::simulate::{Condition, SimMetrics, resolve};
 use super::synth::{add_noise, default_conditions, truth_metrics};
-use super::trials::{Measurement, Metric, TrialSet};
+use super::trials::{Measurement, Metric, Trial, TrialSet};
+use crate::checkpoint::{Shard, SweepPoint, append_to, finish_points, open_log, spec_line};
+use crate::regression::dist::{binomial_interval, binomial_upper_bound};
+use crate::sim::Design;
 
+pub const BENCHMARK_KIND: &str = "gap-benchmark";
+
+#[derive(Clone, Debug, Serialize)]
 pub struct BenchmarkOptions {
     pub design: String,
-    pub seeds: u64,
+    /// Noise levels of the null and single-effect cases.
     pub noise_levels: Vec<f64>,
-    /// Magnitudes as multiples of the identification threshold at 5 % noise.
+    /// Null cases per noise level (main suite).
+    pub null_cases: u64,
+    /// Seeds per non-null case.
+    pub seeds: u64,
+    /// Single effects at these multiples of their identification threshold.
     pub multiples: Vec<f64>,
+    /// Noise of the pair, parameter-error and Drake cases.
+    pub pair_noise: f64,
+    pub pair_multiple: f64,
+    /// Nominal-parameter errors: each a list of `path=value` (the design at 1×).
+    pub parameter_errors: Vec<Vec<(String, f64)>>,
+    pub parameter_noise: Vec<f64>,
+    /// Folder of the Drake trials (`tests/golden/drake/gap`), if any.
+    pub drake_dir: Option<PathBuf>,
+    pub drake_seeds: u64,
+    /// Null cases of the one-robot suite (0: no one-robot suite).
+    pub one_robot_null_cases: u64,
+    /// Run the single-effect cases at this noise again with calibration off.
+    pub calibration_off_noise: Option<f64>,
     pub effects: Vec<String>,
-    /// Null cases (no effect) per noise level.
-    pub null_seeds: u64,
 }
 
-/// Thresholds of one effect at one noise level.
-#[derive(Clone, Debug, Serialize)]
-pub struct ThresholdRow {
-    pub noise: f64,
-    #[serde(flatten)]
-    pub identifiability: Identifiability,
+impl BenchmarkOptions {
+    /// The benchmark for a design (the bundled Mugatu's parameter errors).
+    pub fn standard(design: &str) -> BenchmarkOptions {
+        let p = |v: &[(&str, f64)]| -> Vec<(String, f64)> {
+            v.iter().map(|(k, x)| (k.to_string(), *x)).collect()
+        };
+        BenchmarkOptions {
+            design: design.to_string(),
+            noise_levels: vec![0.01, 0.03, 0.05, 0.10],
+            null_cases: 300,
+            seeds: 3,
+            multiples: vec![1.0, 2.0, 4.0],
+            pair_noise: 0.03,
+            pair_multiple: 2.0,
+            parameter_errors: vec![
+                p(&[("mass.total_mass_kg", 1.08)]),
+                p(&[("mass.total_mass_kg", 0.72)]),
+                p(&[("mass.leg_inertia_box_over_l[0]", 0.9)]),
+                p(&[("mass.leg_inertia_box_over_l[2]", 1.15)]),
+                p(&[("mass.leg_com_height_over_l", 0.495)]),
+                p(&[("mass.leg_com_height_over_l", 0.405)]),
+                p(&[("mass.leg_com_height_over_l", 0.5175)]),
+                p(&[
+                    ("geometry.foot_semi_axes_m[0]", 0.1056),
+                    ("geometry.foot_semi_axes_m[1]", 0.1056),
+                    ("geometry.foot_semi_axes_m[2]", 0.1056),
+                ]),
+                p(&[
+                    ("geometry.foot_semi_axes_m[0]", 0.1344),
+                    ("geometry.foot_semi_axes_m[1]", 0.1344),
+                    ("geometry.foot_semi_axes_m[2]", 0.1344),
+                ]),
+                p(&[("geometry.hip_half_width_over_l", 0.25)]),
+                p(&[("geometry.hip_half_width_over_l", 0.15)]),
+                p(&[("control.kp_over_mgl", 14.0)]),
+                p(&[("control.kd_over_mgl_sqrt_l_over_g", 2.6)]),
+                p(&[("ground.slope_deg", 1.5)]),
+                p(&[("control.amplitude_deg", 28.75)]),
+                p(&[("mass.leg_com_forward_over_l", 0.02)]),
+                p(&[("contact.hunt_crossley_dissipation_s_per_m", 30.0)]),
+            ],
+            parameter_noise: vec![0.03, 0.05],
+            drake_dir: None,
+            drake_seeds: 5,
+            one_robot_null_cases: 100,
+            calibration_off_noise: Some(0.05),
+            effects: Vec::new(),
+        }
+    }
 }
 
-/// One synthetic case and what the diagnosis made of it.
-#[derive(Clone, Debug, Serialize)]
-pub struct CaseRow {
+/// What a case's trials are made from.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub enum Truth {
+    /// The simulator under a setting: parameter values (path, value at 1×) and effects
+    /// (name, magnitude in SI at 1×).
+    Sim {
+        params: Vec<(String, f64)>,
+        effects: Vec<(String, f64)>,
+    },
+    /// A Drake trials file (exact metrics) and the effect added in Drake, if any.
+    Drake {
+        file: String,
+        effect: Option<(String, f64)>,
+    },
+}
+
+/// One case to run.
+#[derive(Clone, Debug)]
+pub struct CaseSpec {
+    pub key: String,
+    pub suite: String,
+    pub kind: String,
     pub noise: f64,
     pub seed: u64,
-    /// None: the null case.
-    pub true_effect: Option<String>,
+    pub calibrate: bool,
     pub multiple: Option<f64>,
-    /// True magnitude in SI (the design at 1×).
-    pub magnitude: Option<f64>,
-    /// Beyond this noise level's identification threshold.
-    pub above_threshold: bool,
-    pub called: Option<String>,
-    pub correct: bool,
-    pub fitted: Option<f64>,
-    pub ci: Option<[f64; 2]>,
-    /// Truth inside the reported interval (when the right effect was called).
-    pub covered: Option<bool>,
-    /// |ln(fitted/true)|.
-    pub log_error: Option<f64>,
+    pub truth: Truth,
+}
+
+/// The outcome of one case: a row of the points file.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct CaseRow {
+    pub key: String,
+    pub suite: String,
+    /// null, effect, pair, parameter, drake.
+    pub kind: String,
+    pub noise: f64,
+    pub seed: u64,
+    pub calibrate: bool,
+    pub multiple: Option<f64>,
+    /// What made the trials, as `name=value` pairs joined by `;` (empty: nothing).
+    pub truth_effects: String,
+    pub truth_params: String,
+    /// The parameter-error truth is a declared uncertain parameter of the design.
+    pub truth_declared: bool,
+    pub answer: String,
+    /// Named knobs (`;`-joined): effects, and parameters as `design:path`.
+    pub named_effects: String,
+    pub named_params: String,
+    /// Named knobs with their 95 % intervals: `knob=lo..hi` joined by `;`.
+    pub intervals: String,
+    /// Groups of knobs the trials could not tell apart (`a|b` joined by `;`): not named.
+    pub ambiguous: String,
+    /// Leads of a partly explained answer (`;`-joined): not named.
+    pub leads: String,
     pub gap_before: f64,
     pub gap_after: Option<f64>,
-    pub shrink_pct: Option<f64>,
-}
-
-/// Counts of calls per true effect (rows) at one noise level, over the cases above
-/// threshold and the null cases.
-#[derive(Clone, Debug, Serialize)]
-pub struct Confusion {
-    pub noise: f64,
-    /// Row and column labels: the effects, then "none".
-    pub labels: Vec<String>,
-    pub counts: Vec<Vec<usize>>,
-    pub identification_rate_above_threshold: f64,
-    pub cases_above_threshold: usize,
-    pub false_alarms: usize,
-    pub null_cases: usize,
-    /// Share of correctly called cases whose interval holds the truth.
-    pub coverage: f64,
-    pub median_log_error: f64,
-    pub median_shrink_pct: f64,
-}
-
-#[derive(Clone, Debug, Serialize)]
-pub struct BenchmarkResult {
-    pub design: String,
-    pub conditions: usize,
-    pub seeds: u64,
-    pub null_seeds: u64,
-    pub multiples: Vec<f64>,
-    pub thresholds: Vec<ThresholdRow>,
-    pub confusion: Vec<Confusion>,
-    pub cases: Vec<CaseRow>,
     pub walks: usize,
-    pub seconds: f64,
-    pub seconds_per_diagnosis: f64,
 }
 
-/// The magnitude `multiple` times as strong as `threshold` (nondimensional), moving away
-/// from the effect's off value, clamped to the plausible range.
-fn magnitude_at(def: &EffectDef, off: f64, threshold: f64, multiple: f64) -> f64 {
-    let [lo, hi] = def.magnitude().range;
+impl SweepPoint for CaseRow {
+    fn key(&self) -> String {
+        self.key.clone()
+    }
+}
+
+fn split(s: &str) -> Vec<String> {
+    s.split(';')
+        .filter(|x| !x.is_empty())
+        .map(str::to_string)
+        .collect()
+}
+
+fn pairs(v: &[(String, f64)]) -> String {
+    v.iter()
+        .map(|(k, x)| format!("{k}={x}"))
+        .collect::<Vec<_>>()
+        .join(";")
+}
+
+fn parse_pairs(s: &str) -> Vec<(String, f64)> {
+    split(s)
+        .into_iter()
+        .filter_map(|p| {
+            let (k, v) = p.split_once('=')?;
+            Some((k.to_string(), v.parse().ok()?))
+        })
+        .collect()
+}
+
+/// A deterministic 64-bit seed from a case key (FNV-1a).
+fn seed_of(key: &str) -> u64 {
+    let mut h: u64 = 0xcbf2_9ce4_8422_2325;
+    for b in key.as_bytes() {
+        h ^= *b as u64;
+        h = h.wrapping_mul(0x0000_0100_0000_01b3);
+    }
+    h
+}
+
+/// The conditions of the one-robot suite: the design at its own size, drive frequency
+/// 0.97–1.03 × its own, amplitude ±4° (servo designs), payload +10 % and +20 %, slope ±1°.
+pub fn one_robot_conditions(design_name: &str) -> Result<Vec<Trial>, GapError> {
+    let d = Design::resolve(design_name).map_err(|e| GapError::Sim {
+        origin: design_name.to_string(),
+        source: e,
+    })?;
+    let f0 = d.controller().frequency_hz().unwrap_or(1.0);
+    let l = d.geometry.leg_length_m;
+    let m0 = d.mass.total_mass_kg;
+    let servo = matches!(d.control, crate::sim::design::ControlSpec::ServoSine { .. });
+    let a0 = match d.control {
+        crate::sim::design::ControlSpec::ServoSine { amplitude_deg, .. } => Some(amplitude_deg),
+        _ => None,
+    };
+    let mut out = Vec::new();
+    let mut add = |label: &str, f: f64, a: Option<f64>, m: Option<f64>, s: Option<f64>| {
+        let mut t = Trial::condition(design_name, l);
+        t.label = label.to_string();
+        t.frequency_hz = Some((f0 * f * 1e6).round() / 1e6);
+        t.amplitude_deg = a;
+        t.mass_kg = m.map(|k| (m0 * k * 1e6).round() / 1e6);
+        t.slope_deg = s;
+        out.push(t);
+    };
+    for k in [0.97, 1.0, 1.03] {
+        add(&format!("f{k}x"), k, None, None, None);
+    }
+    if servo && let Some(a) = a0 {
+        add("A-4", 1.0, Some(a - 4.0), None, None);
+        add("A+4", 1.0, Some(a + 4.0), None, None);
+    } else {
+        add("f0.985x", 0.985, None, None, None);
+        add("f1.015x", 1.015, None, None, None);
+    }
+    add("m+10%", 1.0, None, Some(1.1), None);
+    add("m+20%", 1.0, None, Some(1.2), None);
+    add("m+20%-f0.97x", 0.97, None, Some(1.2), None);
+    add("m+20%-f1.03x", 1.03, None, Some(1.2), None);
+    add("slope+1", 1.0, None, None, Some(1.0));
+    add("slope-1", 1.0, None, None, Some(-1.0));
+    add("slope+1-m+10%", 1.0, None, Some(1.1), Some(1.0));
+    Ok(out)
+}
+
+/// The per-effect identification thresholds (SI) of a set of conditions at a noise level:
+/// the diagnosis of a noiseless "measurement" of the nominal with that noise's sds. With
+/// `calibrate`, against the other effects, every uncertain parameter and their
+/// recalibration; without, against the other effects only.
+#[allow(clippy::too_many_arguments)]
+pub fn thresholds(
+    set: &TrialSet,
+    conditions: &[Condition],
+    nominal: &[SimMetrics],
+    lib: &EffectLibrary,
+    noise: f64,
+    effects: &[String],
+    calibrate: bool,
+    cache: &SimCache,
+) -> Result<Vec<Identifiability>, GapError> {
+    let mut s = set.clone();
+    for (t, m) in s.trials.iter_mut().zip(nominal) {
+        for metric in Metric::SIMULATED {
+            let v = m.get(metric);
+            if v.is_finite() && v != 0.0 {
+                t.measured[metric.index()] = Some(Measurement {
+                    value: v,
+                    sd: Some(noise * v.abs()),
+                });
+            }
+        }
+        t.source = "nominal".into();
+    }
+    let opts = DiagnoseOptions {
+        effects: effects.to_vec(),
+        calibrate,
+        explanations: false,
+        identifiability: true,
+        ..DiagnoseOptions::default()
+    };
+    Ok(
+        diagnose_conditions(&s, conditions, lib, &opts, cache, &|_| {})?
+            .0
+            .identifiability,
+    )
+}
+
+/// The magnitude (SI) `multiple` times as strong as `threshold`, away from the effect's
+/// off value, kept inside the plausible range by a margin of 15 % (in log): a truth at a
+/// range end is never called (the fit cannot tell it from one beyond), by design.
+fn magnitude_at(
+    lib: &EffectLibrary,
+    design: &Design,
+    effect: &str,
+    threshold: f64,
+    multiple: f64,
+) -> f64 {
+    let Ok(def) = lib.get(effect) else {
+        return threshold;
+    };
+    let p = def.magnitude();
+    let scale = p.scale.value(design);
+    let off = p.off_nondimensional(design, &def.name) * scale;
+    let [lo, hi] = [p.range[0] * scale * 1.15, p.range[1] * scale / 1.15];
     let v = if off == 0.0 {
         threshold * multiple
     } else if off.is_infinite() {
         threshold / multiple
     } else {
-        // An off value inside the range (μ): scale the log-distance from it.
         (off.ln() + multiple * (threshold.ln() - off.ln())).exp()
     };
     v.clamp(lo, hi)
 }
 
-fn median(mut v: Vec<f64>) -> f64 {
-    v.retain(|x| x.is_finite());
-    if v.is_empty() {
-        return f64::NAN;
-    }
-    v.sort_by(f64::total_cmp);
-    let n = v.len();
-    if n % 2 == 1 {
-        v[n / 2]
-    } else {
-        0.5 * (v[n / 2 - 1] + v[n / 2])
+/// A suite's conditions and the walks of its truths.
+struct Suite {
+    name: String,
+    base: TrialSet,
+    conditions: Vec<Condition>,
+    cache: SimCache,
+}
+
+impl Suite {
+    fn new(name: &str, base: TrialSet) -> Result<Suite, GapError> {
+        let conditions = resolve(&base)?;
+        Ok(Suite {
+            name: name.into(),
+            base,
+            conditions,
+            cache: SimCache::default(),
+        })
     }
 }
 
-pub fn run(
+/// Everything the cases of a run need: suites, thresholds, Drake truths.
+pub struct Plan {
+    pub cases: Vec<CaseSpec>,
+    pub thresholds: BTreeMap<String, Vec<(String, Option<f64>)>>,
+    suites: Vec<Suite>,
+    drake: BTreeMap<String, (TrialSet, Vec<SimMetrics>)>,
+}
+
+fn truth_setting(
+    lib: &EffectLibrary,
+    design: &Design,
+    params: &[(String, f64)],
+    effects: &[(String, f64)],
+) -> Result<ModelSetting, GapError> {
+    let mut s = ModelSetting::default();
+    for (p, v) in params {
+        s.params.push((design.name.clone(), p.clone(), *v));
+    }
+    for (e, v) in effects {
+        let def = lib.get(e)?;
+        let mut set: EffectSetting = def.setting(def.magnitude().default);
+        set.nondimensional[0] = v / def.magnitude().scale.value(design);
+        s.effects.push(set);
+    }
+    Ok(s)
+}
+
+/// Builds the list of cases (deterministic; the same for every shard).
+pub fn plan(
     lib: &EffectLibrary,
     opts: &BenchmarkOptions,
     progress: &(dyn Fn(&str) + Sync),
-) -> Result<BenchmarkResult, GapError> {
-    let start = Instant::now();
-    if opts.seeds == 0 || opts.noise_levels.is_empty() || opts.multiples.is_empty() {
-        return Err(GapError::Invalid(
-            "the benchmark needs ≥ 1 seed, noise level and multiple".into(),
-        ));
-    }
-    if let Some(bad) = opts.noise_levels.iter().find(|x| !(**x > 0.0 && **x < 1.0)) {
-        return Err(GapError::Invalid(format!(
-            "noise level {bad}: must be in (0, 1)"
-        )));
-    }
-    let effects = lib.subset(&opts.effects)?;
-    progress("default conditions");
-    let trials = default_conditions(&opts.design)?;
-    let base = TrialSet {
-        origin: format!("benchmark conditions of {}", opts.design),
-        base_dir: std::path::PathBuf::from("."),
-        trials,
-    };
-    let conditions = resolve(&base)?;
-    let first = &conditions[0];
-    let cache = SimCache::default();
-    let dopts = DiagnoseOptions::default();
-    let nominal = cache.get(&conditions, lib, None, &|| {})?;
+) -> Result<Plan, GapError> {
+    let design = Design::resolve(&opts.design).map_err(|e| GapError::Sim {
+        origin: opts.design.clone(),
+        source: e,
+    })?;
+    let effect_names: Vec<String> = lib
+        .subset(&opts.effects)?
+        .iter()
+        .map(|e| e.name.clone())
+        .collect();
+    let mut suites = Vec::new();
+    let mut cases = Vec::new();
+    let mut thr_table: BTreeMap<String, Vec<(String, Option<f64>)>> = BTreeMap::new();
 
-    // Thresholds per noise level: a noiseless "measurement" of the nominal model with the
-    // noise level's sds (the diagnosis of it reports each effect's identifiability).
-    let mut thresholds = Vec::new();
-    for &noise in &opts.noise_levels {
+    progress("default conditions");
+    let main = Suite::new(
+        "main",
+        TrialSet {
+            origin: format!("benchmark conditions of {}", opts.design),
+            base_dir: PathBuf::from("."),
+            trials: default_conditions(&opts.design)?,
+        },
+    )?;
+    let nominal = main
+        .cache
+        .get(&main.conditions, lib, &ModelSetting::nominal(), &|| {})?;
+    let mut noise_for_thr: Vec<f64> = opts.noise_levels.clone();
+    noise_for_thr.push(opts.pair_noise);
+    noise_for_thr.sort_by(f64::total_cmp);
+    noise_for_thr.dedup();
+    let mut thr: BTreeMap<String, BTreeMap<String, f64>> = BTreeMap::new();
+    let mut thr_off: BTreeMap<String, BTreeMap<String, f64>> = BTreeMap::new();
+    for &noise in &noise_for_thr {
         progress(&format!("thresholds at {} % noise", noise * 100.0));
-        let mut set = base.clone();
-        for (t, m) in set.trials.iter_mut().zip(&nominal) {
-            for metric in Metric::SIMULATED {
-                let v = m.get(metric);
-                if v.is_finite() && v != 0.0 {
-                    t.measured[metric.index()] = Some(Measurement {
-                        value: v,
-                        sd: Some(noise * v.abs()),
-                    });
+        if opts.calibration_off_noise == Some(noise) {
+            let off = thresholds(
+                &main.base,
+                &main.conditions,
+                &nominal,
+                lib,
+                noise,
+                &opts.effects,
+                false,
+                &main.cache,
+            )?;
+            thr_off.insert(
+                format!("{noise}"),
+                off.iter()
+                    .filter_map(|i| i.identification_threshold.map(|t| (i.effect.clone(), t)))
+                    .collect(),
+            );
+        }
+        let mut ids = thresholds(
+            &main.base,
+            &main.conditions,
+            &nominal,
+            lib,
+            noise,
+            &opts.effects,
+            true,
+            &main.cache,
+        )?;
+        // Effects the design calibrates as a parameter have no effect knob: their threshold
+        // against the other effects (calibration off).
+        let missing: Vec<String> = effect_names
+            .iter()
+            .filter(|e| !ids.iter().any(|i| &i.effect == *e))
+            .cloned()
+            .collect();
+        if !missing.is_empty() {
+            let off = thresholds(
+                &main.base,
+                &main.conditions,
+                &nominal,
+                lib,
+                noise,
+                &missing,
+                false,
+                &main.cache,
+            )?;
+            ids.extend(off);
+            ids.sort_by(|a, b| a.effect.cmp(&b.effect));
+        }
+        let key = format!("{noise}");
+        // An effect not identifiable within its range has no threshold: no case of it is
+        // made (the report lists it), since "k times the threshold" does not exist.
+        thr_table.insert(
+            key.clone(),
+            ids.iter()
+                .map(|i| (i.effect.clone(), i.identification_threshold))
+                .collect(),
+        );
+        thr.insert(
+            key,
+            ids.iter()
+                .filter_map(|i| i.identification_threshold.map(|t| (i.effect.clone(), t)))
+                .collect(),
+        );
+    }
+    let thr_of = |noise: f64, e: &str| -> Option<f64> {
+        thr.get(&format!("{noise}")).and_then(|m| m.get(e)).copied()
+    };
+    let thr_off_of = |noise: f64, e: &str| -> Option<f64> {
+        thr_off
+            .get(&format!("{noise}"))
+            .and_then(|m| m.get(e))
+            .copied()
+    };
+    let sim_case = |suite: &str,
+                    kind: &str,
+                    noise: f64,
+                    seed: u64,
+                    calibrate: bool,
+                    multiple: Option<f64>,
+                    params: Vec<(String, f64)>,
+                    effects: Vec<(String, f64)>| {
+        let truth = Truth::Sim { params, effects };
+        let key = format!(
+            "{suite}/{kind}/{}/{}/n{noise}/s{seed}{}",
+            match &truth {
+                Truth::Sim { effects, .. } => pairs(effects),
+                Truth::Drake { .. } => String::new(),
+            },
+            match &truth {
+                Truth::Sim { params, .. } => pairs(params),
+                Truth::Drake { .. } => String::new(),
+            },
+            if calibrate { "" } else { "/nocal" }
+        );
+        CaseSpec {
+            key,
+            suite: suite.into(),
+            kind: kind.into(),
+            noise,
+            seed,
+            calibrate,
+            multiple,
+            truth,
+        }
+    };
+    // Nulls.
+    for &noise in &opts.noise_levels {
+        for seed in 0..opts.null_cases {
+            cases.push(sim_case(
+                "main",
+                "null",
+                noise,
+                seed,
+                true,
+                None,
+                vec![],
+                vec![],
+            ));
+        }
+    }
+    // Single effects.
+    let singles = |noise: f64, calibrate: bool, cases: &mut Vec<CaseSpec>| {
+        for e in &effect_names {
+            let t = if calibrate {
+                thr_of(noise, e)
+            } else {
+                thr_off_of(noise, e)
+            };
+            let Some(t) = t else { continue };
+            for &k in &opts.multiples {
+                let mag = magnitude_at(lib, &design, e, t, k);
+                for seed in 0..opts.seeds {
+                    cases.push(sim_case(
+                        "main",
+                        "effect",
+                        noise,
+                        seed,
+                        calibrate,
+                        Some(k),
+                        vec![],
+                        vec![(e.clone(), mag)],
+                    ));
                 }
             }
-            t.source = "nominal".into();
         }
-        let (d, _) = diagnose_conditions(&set, &conditions, lib, &dopts, &cache, &|_| {})?;
-        for i in d.identifiability {
-            thresholds.push(ThresholdRow {
+    };
+    for &noise in &opts.noise_levels {
+        singles(noise, true, &mut cases);
+    }
+    if let Some(noise) = opts.calibration_off_noise {
+        singles(noise, false, &mut cases);
+    }
+    // Pairs.
+    for (i, a) in effect_names.iter().enumerate() {
+        for b in &effect_names[i + 1..] {
+            let (Some(ta), Some(tb)) = (thr_of(opts.pair_noise, a), thr_of(opts.pair_noise, b))
+            else {
+                continue;
+            };
+            let mag = |e: &str| {
+                magnitude_at(
+                    lib,
+                    &design,
+                    e,
+                    if e == a { ta } else { tb },
+                    opts.pair_multiple,
+                )
+            };
+            for seed in 0..opts.seeds {
+                cases.push(sim_case(
+                    "main",
+                    "pair",
+                    opts.pair_noise,
+                    seed,
+                    true,
+                    Some(opts.pair_multiple),
+                    vec![],
+                    vec![(a.clone(), mag(a)), (b.clone(), mag(b))],
+                ));
+            }
+        }
+    }
+    // Nominal-parameter errors.
+    for params in &opts.parameter_errors {
+        for &noise in &opts.parameter_noise {
+            for seed in 0..opts.seeds {
+                cases.push(sim_case(
+                    "main",
+                    "parameter",
+                    noise,
+                    seed,
+                    true,
+                    None,
+                    params.clone(),
+                    vec![],
+                ));
+            }
+        }
+    }
+    suites.push(main);
+
+    // One robot.
+    if opts.one_robot_null_cases > 0 {
+        let one = Suite::new(
+            "one-robot",
+            TrialSet {
+                origin: format!("one-robot conditions of {}", opts.design),
+                base_dir: PathBuf::from("."),
+                trials: one_robot_conditions(&opts.design)?,
+            },
+        )?;
+        let noise = 0.05;
+        for seed in 0..opts.one_robot_null_cases {
+            cases.push(sim_case(
+                "one-robot",
+                "null",
                 noise,
-                identifiability: i,
+                seed,
+                true,
+                None,
+                vec![],
+                vec![],
+            ));
+        }
+        for e in &effect_names {
+            let Some(t) = thr_of(noise, e) else { continue };
+            let mag = magnitude_at(lib, &design, e, t, 2.0);
+            for seed in 0..opts.seeds {
+                cases.push(sim_case(
+                    "one-robot",
+                    "effect",
+                    noise,
+                    seed,
+                    true,
+                    Some(2.0),
+                    vec![],
+                    vec![(e.clone(), mag)],
+                ));
+            }
+        }
+        for params in &opts.parameter_errors {
+            for seed in 0..opts.seeds {
+                cases.push(sim_case(
+                    "one-robot",
+                    "parameter",
+                    noise,
+                    seed,
+                    true,
+                    None,
+                    params.clone(),
+                    vec![],
+                ));
+            }
+        }
+        suites.push(one);
+    }
+
+    // Drake.
+    let mut drake = BTreeMap::new();
+    if let Some(dir) = &opts.drake_dir {
+        let mut files: Vec<PathBuf> = std::fs::read_dir(dir)
+            .map_err(|source| GapError::Read {
+                path: dir.clone(),
+                source,
+            })?
+            .filter_map(|e| e.ok().map(|e| e.path()))
+            .filter(|p| {
+                p.file_name()
+                    .and_then(|f| f.to_str())
+                    .is_some_and(|f| f.starts_with("trials-") && f.ends_with(".csv"))
+            })
+            .collect();
+        files.sort();
+        for f in files {
+            let set = TrialSet::read(&f)?;
+            let name = f
+                .file_stem()
+                .and_then(|s| s.to_str())
+                .unwrap_or("")
+                .to_string();
+            let effect = name
+                .strip_prefix("trials-")
+                .and_then(|rest| rest.rsplit_once('-'))
+                .and_then(|(e, v)| Some((e.to_string(), v.parse::<f64>().ok()?)));
+            let conditions = resolve(&set)?;
+            let truth: Vec<SimMetrics> = set
+                .trials
+                .iter()
+                .map(|t| {
+                    let mut values = [f64::NAN; 8];
+                    for m in Metric::SIMULATED {
+                        if let Some(v) = t.measured(m) {
+                            values[m.index()] = v.value;
+                        }
+                    }
+                    SimMetrics {
+                        values,
+                        fell: values.iter().all(|v| v.is_nan()),
+                    }
+                })
+                .collect();
+            let _ = conditions;
+            for seed in 0..opts.drake_seeds {
+                let key = format!("drake/{name}/n{}/s{seed}", opts.pair_noise);
+                cases.push(CaseSpec {
+                    key,
+                    suite: "drake".into(),
+                    kind: "drake".into(),
+                    noise: opts.pair_noise,
+                    seed,
+                    calibrate: true,
+                    multiple: None,
+                    truth: Truth::Drake {
+                        file: name.clone(),
+                        effect: effect.clone(),
+                    },
+                });
+            }
+            drake.insert(name, (set, truth));
+        }
+        if let Some((set, _)) = drake.values().next() {
+            let mut base = set.clone();
+            for t in base.trials.iter_mut() {
+                t.measured = [None; 8];
+            }
+            suites.push(Suite::new("drake", base)?);
+        }
+    }
+    Ok(Plan {
+        cases,
+        thresholds: thr_table,
+        suites,
+        drake,
+    })
+}
+
+/// The specification line of a benchmark's points file.
+pub fn spec(opts: &BenchmarkOptions) -> String {
+    spec_line(
+        BENCHMARK_KIND,
+        &serde_json::to_string(&(env!("CARGO_PKG_VERSION"), opts)).unwrap_or_default(),
+    )
+}
+
+/// Runs one case.
+fn run_case(
+    case: &CaseSpec,
+    plan: &Plan,
+    lib: &EffectLibrary,
+    design: &Design,
+) -> Result<CaseRow, GapError> {
+    let suite = plan
+        .suites
+        .iter()
+        .find(|s| s.name == case.suite)
+        .ok_or_else(|| GapError::Invalid(format!("no suite {}", case.suite)))?;
+    let (truth, truth_effects, truth_params, declared) = match &case.truth {
+        Truth::Sim { params, effects } => {
+            let setting = truth_setting(lib, design, params, effects)?;
+            let t = if setting == ModelSetting::nominal() {
+                suite.cache.get(&suite.conditions, lib, &setting, &|| {})?
+            } else {
+                truth_metrics(&suite.conditions, lib, &setting, &|| {})?
+            };
+            let declared = !params.is_empty()
+                && params
+                    .iter()
+                    .all(|(p, _)| design.uncertain.iter().any(|u| &u.path == p));
+            (t, pairs(effects), pairs(params), declared)
+        }
+        Truth::Drake { file, effect } => {
+            let (_, t) = plan
+                .drake
+                .get(file)
+                .ok_or_else(|| GapError::Invalid(format!("no Drake trials {file}")))?;
+            let e = effect.iter().cloned().collect::<Vec<_>>();
+            (t.clone(), pairs(&e), String::new(), false)
+        }
+    };
+    let trials = add_noise(
+        &suite.base.trials,
+        &truth,
+        case.noise,
+        seed_of(&case.key),
+        "benchmark",
+    );
+    let set = TrialSet {
+        origin: case.key.clone(),
+        base_dir: suite.base.base_dir.clone(),
+        trials,
+    };
+    let opts = DiagnoseOptions {
+        effects: Vec::new(),
+        calibrate: case.calibrate,
+        explanations: false,
+        identifiability: false,
+        ..DiagnoseOptions::default()
+    };
+    let walks0 = suite.cache.walks();
+    let (d, _) = diagnose_conditions(&set, &suite.conditions, lib, &opts, &suite.cache, &|_| {})?;
+    let named_effects: Vec<String> = d.answer.effects.iter().map(|n| n.knob.clone()).collect();
+    let named_params: Vec<String> = d.answer.parameters.iter().map(|n| n.knob.clone()).collect();
+    let intervals: Vec<String> = d
+        .answer
+        .effects
+        .iter()
+        .chain(&d.answer.parameters)
+        .map(|n| format!("{}={}..{}", n.knob, n.interval[0], n.interval[1]))
+        .collect();
+    Ok(CaseRow {
+        key: case.key.clone(),
+        suite: case.suite.clone(),
+        kind: case.kind.clone(),
+        noise: case.noise,
+        seed: case.seed,
+        calibrate: case.calibrate,
+        multiple: case.multiple,
+        truth_effects,
+        truth_params,
+        truth_declared: declared,
+        answer: format!("{:?}", d.answer.kind),
+        named_effects: named_effects.join(";"),
+        named_params: named_params.join(";"),
+        intervals: intervals.join(";"),
+        leads: d
+            .answer
+            .leads
+            .iter()
+            .map(|n| n.knob.clone())
+            .collect::<Vec<_>>()
+            .join(";"),
+        ambiguous: d
+            .answer
+            .ambiguous
+            .iter()
+            .map(|g| g.join("|"))
+            .collect::<Vec<_>>()
+            .join(";"),
+        gap_before: d.gap_before,
+        gap_after: d.chain.last().map(|s| s.gap_after),
+        walks: suite.cache.walks() - walks0,
+    })
+}
+
+fn error_row(case: &CaseSpec, message: &str) -> CaseRow {
+    let (truth_effects, truth_params) = match &case.truth {
+        Truth::Sim { params, effects } => (pairs(effects), pairs(params)),
+        Truth::Drake { effect, .. } => (
+            pairs(&effect.iter().cloned().collect::<Vec<_>>()),
+            String::new(),
+        ),
+    };
+    CaseRow {
+        key: case.key.clone(),
+        suite: case.suite.clone(),
+        kind: case.kind.clone(),
+        noise: case.noise,
+        seed: case.seed,
+        calibrate: case.calibrate,
+        multiple: case.multiple,
+        truth_effects,
+        truth_params,
+        truth_declared: false,
+        answer: format!("NotDiagnosed: {message}"),
+        named_effects: String::new(),
+        named_params: String::new(),
+        intervals: String::new(),
+        ambiguous: String::new(),
+        leads: String::new(),
+        gap_before: f64::NAN,
+        gap_after: None,
+        walks: 0,
+    }
+}
+
+/// Runs the plan's cases of `shard` (all when whole), appending each finished case to the
+/// points file; returns every row of the file (done before and now).
+pub fn run(
+    lib: &EffectLibrary,
+    opts: &BenchmarkOptions,
+    plan: &Plan,
+    points: Option<&Path>,
+    shard: Shard,
+    progress: &(dyn Fn(&str) + Sync),
+) -> Result<Vec<CaseRow>, GapError> {
+    let design = Design::resolve(&opts.design).map_err(|e| GapError::Sim {
+        origin: opts.design.clone(),
+        source: e,
+    })?;
+    let header = spec(opts);
+    let (log, done) = open_log::<CaseRow>(points, &header)?;
+    let todo: Vec<&CaseSpec> = plan
+        .cases
+        .iter()
+        .enumerate()
+        .filter(|(k, c)| shard.takes(*k) && !done.contains_key(&c.key))
+        .map(|(_, c)| c)
+        .collect();
+    let total = todo.len();
+    let count = std::sync::atomic::AtomicUsize::new(0);
+    let new: Vec<CaseRow> = todo
+        .par_iter()
+        .map(|c| {
+            // A case whose trials cannot be diagnosed (the truth made every walk fall, so
+            // nothing was measured) is a row saying so, not the end of the benchmark.
+            let row = match run_case(c, plan, lib, &design) {
+                Ok(r) => r,
+                Err(GapError::File { message, .. }) => error_row(c, &message),
+                Err(e) => return Err(e),
+            };
+            append_to(log.as_ref(), &row)?;
+            let k = count.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1;
+            progress(&format!("{k}/{total} cases ({})", c.key));
+            Ok(row)
+        })
+        .collect::<Result<_, GapError>>()?;
+    let mut rows: Vec<CaseRow> = done.into_values().chain(new).collect();
+    rows.sort_by(|a, b| a.key.cmp(&b.key));
+    if let Some(p) = points
+        && shard == Shard::WHOLE
+    {
+        finish_points(p, &header, &rows)?;
+    }
+    Ok(rows)
+}
+
+/// One line of a score table.
+#[derive(Clone, Debug, Serialize)]
+pub struct Score {
+    pub what: String,
+    pub k: usize,
+    pub n: usize,
+    pub rate: f64,
+    /// 95 % Clopper–Pearson interval of the rate.
+    pub interval: [f64; 2],
+    /// One-sided 95 % upper bound.
+    pub upper_95: f64,
+    pub target: String,
+}
+
+fn score(what: &str, k: usize, n: usize, target: &str) -> Score {
+    let (interval, upper) = if n > 0 {
+        (
+            binomial_interval(k as u64, n as u64, 0.95).unwrap_or([f64::NAN; 2]),
+            binomial_upper_bound(k as u64, n as u64, 0.95).unwrap_or(f64::NAN),
+        )
+    } else {
+        ([f64::NAN; 2], f64::NAN)
+    };
+    Score {
+        what: what.into(),
+        k,
+        n,
+        rate: if n > 0 { k as f64 / n as f64 } else { f64::NAN },
+        interval,
+        upper_95: upper,
+        target: target.into(),
+    }
+}
+
+/// A confusion matrix: rows the truths, columns what was named first.
+#[derive(Clone, Debug, Serialize)]
+pub struct Confusion {
+    pub title: String,
+    pub rows: Vec<String>,
+    pub columns: Vec<String>,
+    pub counts: Vec<Vec<usize>>,
+}
+
+#[derive(Clone, Debug, Serialize)]
+pub struct BenchmarkSummary {
+    pub design: String,
+    pub cases: usize,
+    pub scores: Vec<Score>,
+    pub confusions: Vec<Confusion>,
+    /// Thresholds (SI) per noise level and effect.
+    pub thresholds: BTreeMap<String, Vec<(String, Option<f64>)>>,
+}
+
+/// Does the case name the truth's effect `e` (or the parameter it is an alias of)?
+fn names_effect(row: &CaseRow, e: &str, aliases: &BTreeMap<String, String>) -> bool {
+    split(&row.named_effects).iter().any(|n| n == e)
+        || aliases.get(e).is_some_and(|p| {
+            split(&row.named_params)
+                .iter()
+                .any(|n| n.ends_with(&format!(":{p}")))
+        })
+}
+
+/// Is `v` inside a named interval of `knob` (a knob label or `:path` suffix)?
+fn covered(row: &CaseRow, knob: &dyn Fn(&str) -> bool, v: f64) -> Option<bool> {
+    split(&row.intervals).iter().find_map(|iv| {
+        let (k, r) = iv.split_once('=')?;
+        if !knob(k) {
+            return None;
+        }
+        let (lo, hi) = r.split_once("..")?;
+        let (lo, hi): (f64, f64) = (lo.parse().ok()?, hi.parse().ok()?);
+        Some(v >= lo.min(hi) * (1.0 - 1e-9) - 1e-12 && v <= hi.max(lo) * (1.0 + 1e-9) + 1e-12)
+    })
+}
+
+/// The scores of the rows (any subset: one shard's, or merged).
+pub fn summarize(
+    rows: &[CaseRow],
+    lib: &EffectLibrary,
+    opts: &BenchmarkOptions,
+    thresholds: BTreeMap<String, Vec<(String, Option<f64>)>>,
+) -> BenchmarkSummary {
+    let design = Design::resolve(&opts.design).ok();
+    let aliases: BTreeMap<String, String> = lib
+        .effects
+        .iter()
+        .filter_map(|e| {
+            let f = e.replaces.clone()?;
+            design
+                .as_ref()
+                .is_some_and(|d| d.uncertain.iter().any(|u| u.path == f))
+                .then(|| (e.name.clone(), f))
+        })
+        .collect();
+    let mut scores = Vec::new();
+    let any_named = |r: &CaseRow| !r.named_effects.is_empty() || !r.named_params.is_empty();
+    let effect_named = |r: &CaseRow| !r.named_effects.is_empty();
+    // Nulls.
+    let mut noise_levels: Vec<f64> = rows.iter().map(|r| r.noise).collect();
+    noise_levels.sort_by(f64::total_cmp);
+    noise_levels.dedup();
+    for suite in ["main", "one-robot"] {
+        for &noise in &noise_levels {
+            let nulls: Vec<&CaseRow> = rows
+                .iter()
+                .filter(|r| r.suite == suite && r.kind == "null" && r.noise == noise)
+                .collect();
+            if nulls.is_empty() {
+                continue;
+            }
+            scores.push(score(
+                &format!(
+                    "{suite}: false alarms (anything named) at {:.0} % noise",
+                    noise * 100.0
+                ),
+                nulls.iter().filter(|r| any_named(r)).count(),
+                nulls.len(),
+                "≤ 1 %",
+            ));
+        }
+    }
+    // Single effects, per noise level, multiple ≥ 1.
+    for suite in ["main", "one-robot"] {
+        for calibrate in [true, false] {
+            for &noise in &noise_levels {
+                let cases: Vec<&CaseRow> = rows
+                    .iter()
+                    .filter(|r| {
+                        r.suite == suite
+                            && r.kind == "effect"
+                            && r.noise == noise
+                            && r.calibrate == calibrate
+                    })
+                    .collect();
+                if cases.is_empty() {
+                    continue;
+                }
+                let right = cases
+                    .iter()
+                    .filter(|r| {
+                        let t = parse_pairs(&r.truth_effects);
+                        t.iter().all(|(e, _)| names_effect(r, e, &aliases))
+                    })
+                    .count();
+                let wrong = cases
+                    .iter()
+                    .filter(|r| {
+                        let t = parse_pairs(&r.truth_effects);
+                        split(&r.named_effects)
+                            .iter()
+                            .any(|n| !t.iter().any(|(e, _)| e == n))
+                    })
+                    .count();
+                let tag = if calibrate { "" } else { " (calibration off)" };
+                scores.push(score(
+                    &format!("{suite}: single effect named{tag} at {:.0} % noise (×1, ×2, ×4 thresholds)", noise * 100.0),
+                    right,
+                    cases.len(),
+                    "high",
+                ));
+                scores.push(score(
+                    &format!(
+                        "{suite}: another effect named{tag} at {:.0} % noise",
+                        noise * 100.0
+                    ),
+                    wrong,
+                    cases.len(),
+                    "low",
+                ));
+            }
+        }
+    }
+    // Pairs.
+    let pairs_rows: Vec<&CaseRow> = rows.iter().filter(|r| r.kind == "pair").collect();
+    if !pairs_rows.is_empty() {
+        let both = pairs_rows
+            .iter()
+            .filter(|r| {
+                parse_pairs(&r.truth_effects)
+                    .iter()
+                    .all(|(e, _)| names_effect(r, e, &aliases))
+            })
+            .count();
+        let third = pairs_rows
+            .iter()
+            .filter(|r| {
+                let t = parse_pairs(&r.truth_effects);
+                let extra_effect = split(&r.named_effects)
+                    .iter()
+                    .any(|n| !t.iter().any(|(e, _)| e == n));
+                let extra_param = split(&r.named_params).iter().any(|n| {
+                    !t.iter().any(|(e, _)| {
+                        aliases
+                            .get(e)
+                            .is_some_and(|p| n.ends_with(&format!(":{p}")))
+                    })
+                });
+                extra_effect || extra_param
+            })
+            .count();
+        scores.push(score(
+            "pairs of effects at 2× thresholds: both named",
+            both,
+            pairs_rows.len(),
+            "≥ 80 %",
+        ));
+        scores.push(score(
+            "pairs: a spurious third knob named",
+            third,
+            pairs_rows.len(),
+            "≤ 5 %",
+        ));
+    }
+    // Parameter errors.
+    for suite in ["main", "one-robot"] {
+        let p: Vec<&CaseRow> = rows
+            .iter()
+            .filter(|r| r.suite == suite && r.kind == "parameter")
+            .collect();
+        if p.is_empty() {
+            continue;
+        }
+        scores.push(score(
+            &format!("{suite}: parameter errors: a library effect wrongly called"),
+            p.iter().filter(|r| effect_named(r)).count(),
+            p.len(),
+            "≤ 5 %",
+        ));
+        let wrong_param = |r: &&&CaseRow| {
+            let truth: Vec<String> = parse_pairs(&r.truth_params)
+                .into_iter()
+                .map(|(k, _)| k)
+                .collect();
+            split(&r.named_params)
+                .iter()
+                .any(|n| !truth.iter().any(|t| n.ends_with(&format!(":{t}"))))
+        };
+        scores.push(score(
+            &format!("{suite}: parameter errors: a wrong parameter named"),
+            p.iter().filter(wrong_param).count(),
+            p.len(),
+            "≤ 10 %",
+        ));
+        let declared: Vec<&&CaseRow> = p.iter().filter(|r| r.truth_declared).collect();
+        scores.push(score(
+            &format!("{suite}: parameter errors in a declared parameter: the right one named"),
+            declared
+                .iter()
+                .filter(|r| {
+                    let truth: Vec<String> = parse_pairs(&r.truth_params)
+                        .into_iter()
+                        .map(|(k, _)| k)
+                        .collect();
+                    truth.iter().all(|t| {
+                        split(&r.named_params)
+                            .iter()
+                            .any(|n| n.ends_with(&format!(":{t}")))
+                    })
+                })
+                .count(),
+            declared.len(),
+            "high",
+        ));
+        let undeclared: Vec<&&CaseRow> = p.iter().filter(|r| !r.truth_declared).collect();
+        scores.push(score(
+            &format!("{suite}: parameter errors outside the declared parameters: reported unexplained (nothing named)"),
+            undeclared.iter().filter(|r| !any_named(r)).count(),
+            undeclared.len(),
+            "high",
+        ));
+    }
+    // Drake.
+    let drake: Vec<&CaseRow> = rows.iter().filter(|r| r.kind == "drake").collect();
+    if !drake.is_empty() {
+        let nulls: Vec<&&CaseRow> = drake
+            .iter()
+            .filter(|r| r.truth_effects.is_empty())
+            .collect();
+        scores.push(score(
+            "Drake, no effect added: an effect blamed",
+            nulls.iter().filter(|r| effect_named(r)).count(),
+            nulls.len(),
+            "0 %",
+        ));
+        let with: Vec<&&CaseRow> = drake
+            .iter()
+            .filter(|r| !r.truth_effects.is_empty())
+            .collect();
+        scores.push(score(
+            "Drake, effect added: that effect named (on top of the engine difference)",
+            with.iter()
+                .filter(|r| {
+                    parse_pairs(&r.truth_effects)
+                        .iter()
+                        .all(|(e, _)| names_effect(r, e, &aliases))
+                })
+                .count(),
+            with.len(),
+            "high",
+        ));
+        scores.push(score(
+            "Drake, effect added: another effect named",
+            with.iter()
+                .filter(|r| {
+                    let t = parse_pairs(&r.truth_effects);
+                    split(&r.named_effects)
+                        .iter()
+                        .any(|n| !t.iter().any(|(e, _)| e == n))
+                })
+                .count(),
+            with.len(),
+            "low",
+        ));
+    }
+    // Interval coverage over every case whose true knob was named with an interval.
+    let mut cov = (0usize, 0usize);
+    for r in rows {
+        for (e, v) in parse_pairs(&r.truth_effects) {
+            if r.kind == "drake" {
+                continue;
+            }
+            let alias = aliases.get(&e).cloned();
+            let is = |k: &str| {
+                k == e
+                    || alias
+                        .as_ref()
+                        .is_some_and(|p| k.ends_with(&format!(":{p}")))
+            };
+            if let Some(c) = covered(r, &is, v) {
+                cov.1 += 1;
+                cov.0 += c as usize;
+            }
+        }
+        let params = parse_pairs(&r.truth_params);
+        if params.len() == 1 {
+            let (p, v) = &params[0];
+            let is = |k: &str| k.ends_with(&format!(":{p}"));
+            if let Some(c) = covered(r, &is, *v) {
+                cov.1 += 1;
+                cov.0 += c as usize;
+            }
+        }
+    }
+    scores.push(score(
+        "95 % intervals holding the truth (every case that named its true knob)",
+        cov.0,
+        cov.1,
+        "90–97 %",
+    ));
+    // Confusions: single effects (main, calibration on) by noise; parameter errors.
+    let mut confusions = Vec::new();
+    for calibrate in [true, false] {
+        for &noise in &noise_levels {
+            let cases: Vec<&CaseRow> = rows
+                .iter()
+                .filter(|r| {
+                    r.suite == "main"
+                        && (r.kind == "effect" || r.kind == "null")
+                        && r.noise == noise
+                        && r.calibrate == calibrate
+                })
+                .collect();
+            if cases.iter().all(|r| r.kind == "null") {
+                continue;
+            }
+            let mut row_labels: Vec<String> = Vec::new();
+            let mut col_labels: Vec<String> = Vec::new();
+            let first = |r: &CaseRow| -> String {
+                split(&r.named_effects)
+                    .first()
+                    .cloned()
+                    .or_else(|| {
+                        split(&r.named_params)
+                            .first()
+                            .map(|p| format!("param {}", p.split(':').nth(1).unwrap_or(p)))
+                    })
+                    .unwrap_or_else(|| "none".into())
+            };
+            for r in &cases {
+                let t = parse_pairs(&r.truth_effects)
+                    .first()
+                    .map(|(e, _)| e.clone())
+                    .unwrap_or_else(|| "null".into());
+                if !row_labels.contains(&t) {
+                    row_labels.push(t);
+                }
+                let c = first(r);
+                if !col_labels.contains(&c) {
+                    col_labels.push(c);
+                }
+            }
+            row_labels.sort();
+            col_labels.sort();
+            let mut counts = vec![vec![0; col_labels.len()]; row_labels.len()];
+            for r in &cases {
+                let t = parse_pairs(&r.truth_effects)
+                    .first()
+                    .map(|(e, _)| e.clone())
+                    .unwrap_or_else(|| "null".into());
+                let (Some(i), Some(j)) = (
+                    row_labels.iter().position(|x| *x == t),
+                    col_labels.iter().position(|x| *x == first(r)),
+                ) else {
+                    continue;
+                };
+                counts[i][j] += 1;
+            }
+            confusions.push(Confusion {
+                title: format!(
+                    "single effects and nulls at {:.0} % noise{}",
+                    noise * 100.0,
+                    if calibrate { "" } else { ", calibration off" }
+                ),
+                rows: row_labels,
+                columns: col_labels,
+                counts,
             });
         }
     }
-    let threshold_of = |effect: &str, noise: f64| -> Option<f64> {
-        thresholds
+    {
+        let cases: Vec<&CaseRow> = rows
             .iter()
-            .find(|t| t.identifiability.effect == effect && (t.noise - noise).abs() < 1e-12)
-            .and_then(|t| {
-                t.identifiability
-                    .identification_threshold
-                    .or(t.identifiability.detection_threshold)
-            })
-    };
-    // Reference noise for the magnitudes: 5 % if benchmarked, else the middle level.
-    let ref_noise = opts
-        .noise_levels
-        .iter()
-        .copied()
-        .find(|n| (n - 0.05).abs() < 1e-12)
-        .unwrap_or(opts.noise_levels[opts.noise_levels.len() / 2]);
-
-    // Truth walks for every (effect, multiple).
-    let mut truths: Vec<(Option<&EffectDef>, Option<f64>, Option<EffectSetting>)> =
-        vec![(None, None, None)];
-    for def in &effects {
-        let p = def.magnitude();
-        let scale = p.scale.value(&first.design);
-        let off = p.off_nondimensional(&first.design, &def.name);
-        let thr = threshold_of(&def.name, ref_noise).map(|t| t / scale);
-        for &k in &opts.multiples {
-            let mag = match thr {
-                Some(t) => magnitude_at(def, off, t, k),
-                // Not identifiable within the range: its strongest plausible magnitude.
-                None => {
-                    if off == 0.0 {
-                        p.range[1]
-                    } else {
-                        p.range[0]
-                    }
+            .filter(|r| r.suite == "main" && r.kind == "parameter")
+            .collect();
+        if !cases.is_empty() {
+            let mut row_labels: Vec<String> = Vec::new();
+            let mut col_labels: Vec<String> = Vec::new();
+            let label = |r: &CaseRow| -> String {
+                let mut v: Vec<String> = split(&r.named_params)
+                    .iter()
+                    .map(|p| p.split(':').nth(1).unwrap_or(p).to_string())
+                    .collect();
+                v.extend(split(&r.named_effects));
+                if v.is_empty() {
+                    "none".into()
+                } else {
+                    v.join(" + ")
                 }
             };
-            truths.push((Some(def), Some(k), Some(def.setting(mag))));
-        }
-    }
-    progress("truth walks");
-    let truth_metrics: Vec<_> = truths
-        .iter()
-        .map(|(_, _, s)| match s {
-            Some(s) => truth_metrics(&conditions, lib, std::slice::from_ref(s), &|| {}),
-            None => Ok(nominal.clone()),
-        })
-        .collect::<Result<_, _>>()?;
-
-    let mut cases = Vec::new();
-    let mut diag_seconds = 0.0;
-    let mut n_diag = 0usize;
-    for &noise in &opts.noise_levels {
-        for ((def, k, setting), truth) in truths.iter().zip(&truth_metrics) {
-            let seeds = if def.is_none() {
-                opts.null_seeds
-            } else {
-                opts.seeds
-            };
-            for seed in 0..seeds {
-                progress(&format!(
-                    "{} × {} at {} % noise, seed {seed}",
-                    def.map(|d| d.name.as_str()).unwrap_or("null"),
-                    k.unwrap_or(0.0),
-                    noise * 100.0
-                ));
-                let case_seed = seed
-                    .wrapping_mul(1_000_003)
-                    .wrapping_add((noise * 1e6) as u64)
-                    .wrapping_add(cases.len() as u64 * 7919);
-                let trials = add_noise(&base.trials, truth, noise, case_seed, "benchmark");
-                let set = TrialSet {
-                    origin: "benchmark".into(),
-                    base_dir: base.base_dir.clone(),
-                    trials,
-                };
-                let t0 = Instant::now();
-                let (d, _) = diagnose_conditions(&set, &conditions, lib, &dopts, &cache, &|_| {})?;
-                diag_seconds += t0.elapsed().as_secs_f64();
-                n_diag += 1;
-                let called = d.best.as_ref().map(|b| b.effect.clone());
-                let true_name = def.map(|d| d.name.clone());
-                let correct = called == true_name;
-                let (magnitude, above) = match (def, setting) {
-                    (Some(def), Some(s)) => {
-                        let p = def.magnitude();
-                        let scale = p.scale.value(&first.design);
-                        let off = p.off_nondimensional(&first.design, &def.name);
-                        let m = s.nondimensional[0];
-                        let above = threshold_of(&def.name, noise)
-                            .map(|t| {
-                                let t = t / scale;
-                                if off == 0.0 {
-                                    m >= t * (1.0 - 1e-9)
-                                } else if off.is_infinite() {
-                                    m <= t * (1.0 + 1e-9)
-                                } else {
-                                    (m.ln() - off.ln()).abs()
-                                        >= (t.ln() - off.ln()).abs() * (1.0 - 1e-9)
-                                }
-                            })
-                            .unwrap_or(false);
-                        (Some(m * scale), above)
-                    }
-                    _ => (None, false),
-                };
-                let (fitted, ci) = match (&d.best, def) {
-                    (Some(b), Some(def)) if correct => (
-                        b.params.get(&def.magnitude().name).copied(),
-                        b.params_ci.get(&def.magnitude().name).copied(),
-                    ),
-                    _ => (None, None),
-                };
-                let covered = match (ci, magnitude) {
-                    (Some([lo, hi]), Some(m)) => {
-                        Some(m >= lo * (1.0 - 1e-9) && m <= hi * (1.0 + 1e-9))
-                    }
-                    _ => None,
-                };
-                let log_error = match (fitted, magnitude) {
-                    (Some(f), Some(m)) => Some((f / m).ln().abs()),
-                    _ => None,
-                };
-                cases.push(CaseRow {
-                    noise,
-                    seed,
-                    true_effect: true_name,
-                    multiple: *k,
-                    magnitude,
-                    above_threshold: above,
-                    called,
-                    correct,
-                    fitted,
-                    ci,
-                    covered,
-                    log_error,
-                    gap_before: d.gap_before,
-                    gap_after: d.best.as_ref().map(|b| b.gap_after),
-                    shrink_pct: d.best.as_ref().map(|b| b.shrink_pct),
-                });
+            for r in &cases {
+                if !row_labels.contains(&r.truth_params) {
+                    row_labels.push(r.truth_params.clone());
+                }
+                let c = label(r);
+                if !col_labels.contains(&c) {
+                    col_labels.push(c);
+                }
             }
-        }
-    }
-
-    let mut labels: Vec<String> = effects.iter().map(|e| e.name.clone()).collect();
-    labels.push("none".into());
-    let idx = |name: &Option<String>| -> usize {
-        match name {
-            Some(n) => labels
-                .iter()
-                .position(|l| l == n)
-                .unwrap_or(labels.len() - 1),
-            None => labels.len() - 1,
-        }
-    };
-    let mut confusion = Vec::new();
-    for &noise in &opts.noise_levels {
-        let mut counts = vec![vec![0usize; labels.len()]; labels.len()];
-        let here: Vec<&CaseRow> = cases
-            .iter()
-            .filter(|c| (c.noise - noise).abs() < 1e-12)
-            .collect();
-        for c in &here {
-            if c.above_threshold || c.true_effect.is_none() {
-                counts[idx(&c.true_effect)][idx(&c.called)] += 1;
+            row_labels.sort();
+            col_labels.sort();
+            let mut counts = vec![vec![0; col_labels.len()]; row_labels.len()];
+            for r in &cases {
+                if let (Some(i), Some(j)) = (
+                    row_labels.iter().position(|x| *x == r.truth_params),
+                    col_labels.iter().position(|x| *x == label(r)),
+                ) {
+                    counts[i][j] += 1;
+                }
             }
+            confusions.push(Confusion {
+                title: "nominal-parameter errors (main suite): what was named".into(),
+                rows: row_labels,
+                columns: col_labels,
+                counts,
+            });
         }
-        let above: Vec<&&CaseRow> = here.iter().filter(|c| c.above_threshold).collect();
-        let nulls: Vec<&&CaseRow> = here.iter().filter(|c| c.true_effect.is_none()).collect();
-        let covered: Vec<bool> = here.iter().filter_map(|c| c.covered).collect();
-        confusion.push(Confusion {
-            noise,
-            labels: labels.clone(),
-            counts,
-            identification_rate_above_threshold: if above.is_empty() {
-                f64::NAN
-            } else {
-                above.iter().filter(|c| c.correct).count() as f64 / above.len() as f64
-            },
-            cases_above_threshold: above.len(),
-            false_alarms: nulls.iter().filter(|c| c.called.is_some()).count(),
-            null_cases: nulls.len(),
-            coverage: if covered.is_empty() {
-                f64::NAN
-            } else {
-                covered.iter().filter(|c| **c).count() as f64 / covered.len() as f64
-            },
-            median_log_error: median(here.iter().filter_map(|c| c.log_error).collect()),
-            median_shrink_pct: median(
-                here.iter()
-                    .filter(|c| c.correct && c.true_effect.is_some())
-                    .filter_map(|c| c.shrink_pct)
-                    .collect(),
-            ),
-        });
     }
-    Ok(BenchmarkResult {
+    BenchmarkSummary {
         design: opts.design.clone(),
-        conditions: conditions.len(),
-        seeds: opts.seeds,
-        null_seeds: opts.null_seeds,
-        multiples: opts.multiples.clone(),
+        cases: rows.len(),
+        scores,
+        confusions,
         thresholds,
-        confusion,
-        cases,
-        walks: cache.walks.load(std::sync::atomic::Ordering::Relaxed),
-        seconds: start.elapsed().as_secs_f64(),
-        seconds_per_diagnosis: diag_seconds / n_diag.max(1) as f64,
-    })
+    }
 }

@@ -1,287 +1,171 @@
-//! The diagnosis: where the nominal simulation misses the trials, which candidate effect
-//! explains the miss, its parameters with intervals, and how far the gap shrinks on
-//! held-out conditions.
+//! The diagnosis: where the nominal simulation misses the trials, and which of three kinds
+//! of explanation the trials support — **nominal parameters off** (the design's declared
+//! uncertain values, calibrated), **an effect missing** (the library's, tested with the
+//! parameters free as a nuisance), **both** — or that they support none ("unexplained").
 //!
-//! Method. Every observation (trial × metric) gives a standardised residual
-//! z = (simulated − measured)/sd, sd the trial's, or [`DiagnoseOptions::default_relative_sd`]
-//! of the value where none is stated. The gap is the RMS of z (the weighted RMS of the
-//! residuals, weights 1/sd²); χ² = Σz².
-//!
-//! Each candidate effect is simulated on every condition at [`DiagnoseOptions::grid_points`]
-//! log-spaced magnitudes over its plausible range; per condition and metric the magnitude
-//! dependence is a monotone cubic (PCHIP) in ln(magnitude) through those walks, so fitting,
-//! leave-one-condition-out refits and profiles cost no further walks. The nominal model (the
-//! effect off) is one more candidate value. The best candidates are refined with walks at
-//! the optimum and either side of it, which become nodes of the interpolant.
-//!
-//! Ranking: held-out χ² per observation (each condition predicted by the fit to the others)
-//! plus a BIC penalty ln(n)/n per fitted parameter. Significance: the likelihood-ratio
-//! statistic χ²_nominal − χ²_fit against χ²₁ at α/K (K candidates, Bonferroni), and a
-//! held-out gap below the nominal's. Interval: the profile Δχ² ≤ χ²₁(0.95)·max(1, χ²/dof).
+//! Method. Every observation (trial × metric) gives z = (simulated − measured)/sd; the gap
+//! is the RMS of z. Every knob (uncertain parameter, effect magnitude) is walked on a grid
+//! of its plausible range on every condition; the surrogate adds the knobs' changes
+//! ([`super::surrogate`]). Forward selection ([`super::select`]) then adds knobs one at a
+//! time under the call rules; every model it keeps is confirmed by real walks at its fitted
+//! point. The answer names the chain's knobs with profile intervals, checks the final
+//! residuals and says where any rest lies.
 
-use std::collections::HashMap;
-use std::sync::Mutex;
 use std::time::Instant;
 
 use serde::Serialize;
-use statrs::distribution::{ChiSquared, ContinuousCDF, Normal};
 
+use super::cache::SimCache;
+use super::curve::Curve;
 use super::error::GapError;
-use super::library::{EffectDef, EffectLibrary, EffectSetting};
-use super::simulate::{Condition, SimMetrics, resolve};
+use super::fit::{Fit, FitContext, ProfileInterval, dispersion, groupings, lr_p_value};
+use super::identify::{Identifiability, identifiability};
+use super::knob::{KnobKind, Knobs};
+use super::library::EffectLibrary;
+use super::locate::{MetricGap, Residual, metric_gaps, summarize};
+use super::problem::Observation;
+use super::select::{SelectOptions, Step, gap_of, select, within_noise};
+use super::simulate::{Condition, resolve};
+use super::surrogate::Surrogate;
 use super::trials::{Metric, TrialSet};
-use crate::regression::{Method, fit_line};
-
-/// z² charged to an observation whose simulated walk fell (a 10-sd miss).
-pub const FELL_Z2: f64 = 100.0;
-/// Points of the fine grid the interpolated χ² is minimised on.
-const FINE_POINTS: usize = 1601;
+use crate::regression::dist::chi2_upper_p;
 
 #[derive(Clone, Debug)]
 pub struct DiagnoseOptions {
     /// Candidate effects (empty: the whole library).
     pub effects: Vec<String>,
-    /// Magnitudes simulated per candidate over its plausible range.
+    /// Walks per knob over its plausible range.
     pub grid_points: usize,
     /// Relative sd assumed for a measurement that states none.
     pub default_relative_sd: f64,
-    /// Family-wise false-alarm rate of the effect tests.
+    /// Family-wise false-alarm rate of each step's tests.
     pub alpha: f64,
-    /// Candidates refined with extra walks (the best by the coarse score, and the next ones
-    /// within 2.5 times its score).
-    pub refine_top: usize,
+    /// Calibrate the designs' `[[uncertain]]` parameters (off: the nominal model is taken
+    /// as right, only effects are candidates).
+    pub calibrate: bool,
+    /// Compute the identifiability thresholds (a few seconds; the benchmark's cases skip it).
+    pub identifiability: bool,
+    /// Fit the competing explanations side by side and the recalibration table (walks; the
+    /// benchmark's cases skip it: the answer does not depend on it).
+    pub explanations: bool,
+    pub select: SelectOptions,
 }
 
 impl Default for DiagnoseOptions {
     fn default() -> Self {
         DiagnoseOptions {
             effects: Vec::new(),
-            grid_points: 8,
+            grid_points: 9,
             default_relative_sd: 0.10,
             alpha: 0.001,
-            refine_top: 3,
+            calibrate: true,
+            identifiability: true,
+            explanations: true,
+            select: SelectOptions::default(),
         }
     }
 }
 
-/// Walks shared between diagnoses of trials over the same conditions (the benchmark): key =
-/// (condition, effect and its nondimensional values).
-#[derive(Default)]
-pub struct SimCache {
-    map: Mutex<HashMap<(usize, String), SimMetrics>>,
-    pub walks: std::sync::atomic::AtomicUsize,
+/// The kind of answer.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum AnswerKind {
+    /// The nominal model fits within noise; nothing is called.
+    WithinNoise,
+    /// Uncertain parameters of the design, recalibrated, explain the gap (within noise).
+    ParametersOff,
+    /// An effect (or effects) of the library explains the gap (within noise).
+    EffectMissing,
+    /// Both parameters and effects are needed (within noise).
+    Both,
+    /// Knobs shrink the gap but the rest stays beyond noise: they are reported as leads,
+    /// nothing is named.
+    PartlyExplained,
+    /// A real gap that no knob explains under the call rules.
+    Unexplained,
+    /// Knobs explain the gap, but these trials cannot tell which (each step had a rival
+    /// within the identification distance): nothing is named.
+    Ambiguous,
 }
 
-fn key(e: Option<&EffectSetting>) -> String {
-    match e {
-        None => "nominal".into(),
-        Some(s) => {
-            let mut k = s.effect.clone();
-            for v in &s.nondimensional {
-                k.push_str(&format!(":{:016x}", v.to_bits()));
-            }
-            k
-        }
-    }
-}
-
-impl SimCache {
-    /// Metrics of `effect` on every condition, walking only what the cache lacks.
-    pub fn get(
-        &self,
-        conditions: &[Condition],
-        lib: &EffectLibrary,
-        effect: Option<&EffectSetting>,
-        progress: &(dyn Fn() + Sync),
-    ) -> Result<Vec<SimMetrics>, GapError> {
-        self.get_many(conditions, lib, &[effect.cloned()], progress)
-            .map(|mut v| v.remove(0))
-    }
-
-    /// Metrics of several effect settings on every condition, in parallel.
-    pub fn get_many(
-        &self,
-        conditions: &[Condition],
-        lib: &EffectLibrary,
-        effects: &[Option<EffectSetting>],
-        progress: &(dyn Fn() + Sync),
-    ) -> Result<Vec<Vec<SimMetrics>>, GapError> {
-        let keys: Vec<String> = effects.iter().map(|e| key(e.as_ref())).collect();
-        let mut jobs = Vec::new();
-        {
-            let map = self
-                .map
-                .lock()
-                .map_err(|_| GapError::Invalid("cache poisoned".into()))?;
-            for (k, e) in keys.iter().zip(effects) {
-                for i in 0..conditions.len() {
-                    if !map.contains_key(&(i, k.clone())) {
-                        jobs.push((i, e.clone()));
-                    }
-                }
-            }
-        }
-        let done = super::simulate::simulate_jobs(&jobs, conditions, lib, progress)?;
-        self.walks
-            .fetch_add(jobs.len(), std::sync::atomic::Ordering::Relaxed);
-        let mut map = self
-            .map
-            .lock()
-            .map_err(|_| GapError::Invalid("cache poisoned".into()))?;
-        for ((i, e), m) in jobs.iter().zip(done) {
-            map.insert((*i, key(e.as_ref())), m);
-        }
-        let mut out = Vec::new();
-        for k in &keys {
-            let mut v = Vec::with_capacity(conditions.len());
-            for i in 0..conditions.len() {
-                v.push(
-                    *map.get(&(i, k.clone()))
-                        .ok_or_else(|| GapError::Invalid("cache miss after simulation".into()))?,
-                );
-            }
-            out.push(v);
-        }
-        Ok(out)
-    }
-}
-
-/// One observation: a measured metric of a trial with its sd.
-#[derive(Clone, Copy, Debug)]
-pub struct Observation {
-    pub trial: usize,
-    pub metric: Metric,
+/// A knob the answer names, with its fitted value and interval (SI, the design at 1×).
+#[derive(Clone, Debug, Serialize)]
+pub struct Named {
+    pub knob: String,
+    pub kind: KnobKind,
     pub value: f64,
-    pub sd: f64,
-    pub sd_assumed: bool,
+    /// 95 % profile interval (scaled by the over-dispersion).
+    pub interval: [f64; 2],
+    /// The interval reaches an end of the plausible range (open there).
+    pub interval_open: bool,
+    /// Parameters: the design file's value, and the change in % of it.
+    pub nominal: Option<f64>,
+    pub change_pct: Option<f64>,
+    pub unit: String,
+    /// Other knobs the trials cannot tell from this one.
+    pub not_separable_from: Vec<String>,
 }
 
-impl Observation {
-    fn z2(&self, simulated: f64) -> f64 {
-        if simulated.is_finite() {
-            let z = (simulated - self.value) / self.sd;
-            z * z
-        } else {
-            FELL_Z2
-        }
-    }
-}
-
-/// A residual of the nominal (and, once a best effect is found, the corrected) simulation.
 #[derive(Clone, Debug, Serialize)]
-pub struct Residual {
-    pub trial: usize,
-    pub label: String,
-    pub design: String,
-    pub leg_length_m: f64,
-    pub frequency_hz: f64,
-    pub metric: Metric,
-    pub measured: f64,
-    pub sd: f64,
-    pub sd_assumed: bool,
-    pub simulated: Option<f64>,
-    pub z: Option<f64>,
-    /// (simulated − measured)/|measured|.
-    pub relative: Option<f64>,
-    pub simulated_after: Option<f64>,
-    pub z_after: Option<f64>,
-}
-
-/// A linear trend of the relative residual against ln(x).
-#[derive(Clone, Debug, Serialize)]
-pub struct Trend {
-    /// Change of the relative residual per e-fold of x.
-    pub slope: f64,
-    pub se: f64,
-    pub p_value: f64,
-}
-
-/// How one metric carries the gap.
-#[derive(Clone, Debug, Serialize)]
-pub struct MetricGap {
-    pub metric: Metric,
-    pub n: usize,
-    pub rms_z: f64,
-    pub mean_relative_pct: f64,
-    pub chi2: f64,
-    pub p_value: f64,
-    /// χ² beyond noise at level α.
-    pub significant: bool,
-    pub leg_lengths_m: [f64; 2],
-    pub trend_with_leg_length: Option<Trend>,
-    pub trend_with_frequency: Option<Trend>,
-    pub rms_z_after: Option<f64>,
-    /// The gap per design and size.
-    pub regimes: Vec<RegimeGap>,
+pub struct Answer {
+    pub kind: AnswerKind,
+    pub parameters: Vec<Named>,
+    pub effects: Vec<Named>,
+    /// The chain's knobs when the chain leaves the rest beyond noise: leads, not findings
+    /// (`parameters` and `effects` are then empty). Not named.
+    pub leads: Vec<Named>,
+    /// Steps that explain part of the gap but could be any of several knobs: each group
+    /// lists the step's knob and its rivals. Not named.
+    pub ambiguous: Vec<Vec<String>>,
+    /// Where the rest lies when the final model is still beyond noise.
+    pub rest: Option<String>,
     pub statement: String,
 }
 
-/// One metric's gap on the trials of one design at one size.
+/// One competing explanation, fitted and confirmed with walks.
 #[derive(Clone, Debug, Serialize)]
-pub struct RegimeGap {
-    pub design: String,
-    pub leg_length_m: f64,
-    pub n: usize,
-    pub rms_z: f64,
-    pub mean_relative_pct: f64,
-    pub p_value: f64,
-    pub significant: bool,
+pub struct Explanation {
+    /// "nominal", "parameters off (recalibrated)", "effect (parameters nominal)",
+    /// "effect + recalibrated parameters", "chain (the answer)".
+    pub model: String,
+    pub knobs: Vec<(String, f64)>,
+    pub free: usize,
+    pub chi2: f64,
+    /// Held-out gap (RMS z, leave one condition out).
+    pub gap_held_out: f64,
+    pub shrink_pct: f64,
+    /// Likelihood-ratio test against the nominal (df = free knobs, over-dispersion scaled).
+    pub p_vs_nominal: Option<f64>,
+    pub within_noise: bool,
 }
 
-/// A candidate's fit.
+/// One uncertain parameter in the best recalibration: how far it moves and how well these
+/// trials pin it down.
 #[derive(Clone, Debug, Serialize)]
-pub struct RankedEffect {
-    pub effect: String,
-    /// Fitted parameters in SI at the first trial's design at 1× (others at defaults).
-    pub params: std::collections::BTreeMap<String, f64>,
-    /// The magnitude in its natural unit (see `survey gap effects`), None: the fit prefers
-    /// the nominal model.
-    pub magnitude_nondimensional: Option<f64>,
-    /// Held-out gap (RMS z, each condition predicted from the fit to the others).
-    pub gap_after: f64,
+pub struct Calibrated {
+    pub parameter: String,
+    pub nominal: f64,
+    pub value: f64,
+    pub interval: [f64; 2],
+    pub range: [f64; 2],
+    /// Move from the file's value in prior sds (None: uniform prior).
+    pub move_in_sd: Option<f64>,
+    /// Interval width / range width: near 1, the trials do not constrain it.
+    pub width_of_range: f64,
+    pub why: String,
+}
+
+/// A single knob's fit from the nominal (the "which knob alone" table).
+#[derive(Clone, Debug, Serialize)]
+pub struct SingleFit {
+    pub knob: String,
+    pub kind: KnobKind,
+    pub value: f64,
+    pub unit: String,
+    pub gap_held_out: f64,
     pub shrink_pct: f64,
-    /// Held-out χ²/n plus the parameter penalty; lower is better.
-    pub score: f64,
-    pub gap_after_in_sample: f64,
-    /// χ²_nominal − χ²_fit, and its p-value against χ²₁.
     pub lr: f64,
     pub p_value: f64,
-    pub significant: bool,
-    pub refined: bool,
-}
-
-#[derive(Clone, Debug, Serialize)]
-pub struct BestEffect {
-    pub effect: String,
-    pub params: std::collections::BTreeMap<String, f64>,
-    /// 95 % profile interval of the magnitude parameter, in SI.
-    pub params_ci: std::collections::BTreeMap<String, [f64; 2]>,
-    pub magnitude_nondimensional: f64,
-    pub magnitude_ci_nondimensional: [f64; 2],
-    pub gap_after: f64,
-    pub shrink_pct: f64,
-    pub gap_after_in_sample: f64,
-    /// The interval reaches an end of the plausible range (open there).
-    pub ci_at_range_edge: bool,
-}
-
-/// From which metrics an effect shows, and the smallest magnitude these trials detect.
-#[derive(Clone, Debug, Serialize)]
-pub struct Identifiability {
-    pub effect: String,
-    pub parameter: String,
-    pub unit: String,
-    /// Magnitude (SI, first design at 1×) at which the likelihood-ratio test detects the
-    /// effect with 90 % power given these trials' sds; None: not within the range.
-    pub detection_threshold: Option<f64>,
-    /// Magnitude beyond which the effect is also told from every other candidate with
-    /// 90 % probability (its best mimic's χ² excess ≥ (2·z₀.₉)²).
-    pub identification_threshold: Option<f64>,
-    /// The closest mimic at the identification threshold.
-    pub closest_mimic: Option<String>,
-    /// Metrics carrying ≥ 10 % of the detection statistic at the threshold (or at the
-    /// range's end).
-    pub identifiable_from: Vec<Metric>,
 }
 
 #[derive(Clone, Debug, Serialize)]
@@ -297,10 +181,17 @@ pub struct Diagnosis {
     pub summary: String,
     #[serde(rename = "where")]
     pub where_: Vec<MetricGap>,
-    pub ranking: Vec<RankedEffect>,
-    pub best: Option<BestEffect>,
-    pub verdict: String,
+    pub answer: Answer,
+    /// The forward selection's chain.
+    pub chain: Vec<Step>,
+    pub explanations: Vec<Explanation>,
+    /// The best recalibration of every uncertain parameter (empty without calibration).
+    pub calibration: Vec<Calibrated>,
+    /// Every knob alone, from the nominal, on the surrogate.
+    pub single: Vec<SingleFit>,
     pub identifiability: Vec<Identifiability>,
+    /// Effects left out because the design calibrates their quantity.
+    pub aliased: Vec<(String, String)>,
     pub notes: Vec<String>,
     pub residuals: Vec<Residual>,
     pub walks_evaluated: usize,
@@ -311,158 +202,9 @@ pub struct Diagnosis {
 pub struct Timing {
     pub nominal_s: f64,
     pub grid_s: f64,
-    pub refine_s: f64,
-    pub fit_s: f64,
+    pub select_s: f64,
+    pub report_s: f64,
     pub walks: usize,
-}
-
-/// Fritsch–Carlson monotone cubic through (x, y), NaN-aware: NaN where a bracketing node is
-/// NaN. Hand-written: the interpolation crates do not keep monotonicity or handle the NaN
-/// of a fallen walk, and this is twenty lines.
-fn pchip(x: &[f64], y: &[f64], t: f64) -> f64 {
-    let n = x.len();
-    if n == 1 {
-        return y[0];
-    }
-    let k = x.partition_point(|v| *v <= t).clamp(1, n - 1) - 1;
-    let (y0, y1) = (y[k], y[k + 1]);
-    if !(y0.is_finite() && y1.is_finite()) {
-        return f64::NAN;
-    }
-    let h = x[k + 1] - x[k];
-    let d = |i: usize| -> f64 { (y[i + 1] - y[i]) / (x[i + 1] - x[i]) };
-    let slope = |i: usize| -> f64 {
-        let left = if i > 0 { d(i - 1) } else { f64::NAN };
-        let right = if i + 1 < n { d(i) } else { f64::NAN };
-        match (left.is_finite(), right.is_finite()) {
-            (true, true) => {
-                if left * right <= 0.0 {
-                    0.0
-                } else {
-                    let (h0, h1) = (x[i] - x[i - 1], x[i + 1] - x[i]);
-                    let (w1, w2) = (2.0 * h1 + h0, h1 + 2.0 * h0);
-                    (w1 + w2) / (w1 / left + w2 / right)
-                }
-            }
-            (true, false) => left,
-            (false, true) => right,
-            _ => 0.0,
-        }
-    };
-    let (m0, m1) = (slope(k), slope(k + 1));
-    let s = ((t - x[k]) / h).clamp(0.0, 1.0);
-    let (s2, s3) = (s * s, s * s * s);
-    (2.0 * s3 - 3.0 * s2 + 1.0) * y0
-        + (s3 - 2.0 * s2 + s) * h * m0
-        + (-2.0 * s3 + 3.0 * s2) * y1
-        + (s3 - s2) * h * m1
-}
-
-/// A candidate's walks: the metrics at each simulated magnitude (u = ln magnitude), sorted.
-struct Curve {
-    u: Vec<f64>,
-    /// The walks' metric values, [condition][metric index][node], kept beside `u` so that
-    /// evaluating the interpolant (millions of times in profiles and thresholds) allocates
-    /// nothing.
-    series: Vec<Vec<Vec<f64>>>,
-}
-
-impl Curve {
-    /// `sims` is [node][condition].
-    fn new(u: Vec<f64>, sims: Vec<Vec<SimMetrics>>) -> Curve {
-        let n_cond = sims.first().map(Vec::len).unwrap_or(0);
-        let series = (0..n_cond)
-            .map(|c| {
-                Metric::ALL
-                    .iter()
-                    .map(|m| sims.iter().map(|s| s[c].get(*m)).collect())
-                    .collect()
-            })
-            .collect();
-        Curve { u, series }
-    }
-    fn insert(&mut self, u: f64, sims: Vec<SimMetrics>) {
-        if self.u.iter().any(|x| (x - u).abs() < 1e-12) {
-            return;
-        }
-        let k = self.u.partition_point(|x| *x < u);
-        self.u.insert(k, u);
-        for (per_metric, s) in self.series.iter_mut().zip(&sims) {
-            for m in Metric::ALL {
-                per_metric[m.index()].insert(k, s.get(m));
-            }
-        }
-    }
-    fn value(&self, cond: usize, metric: Metric, u: f64) -> f64 {
-        pchip(&self.u, &self.series[cond][metric.index()], u)
-    }
-}
-
-/// The per-condition χ² of a candidate on a fine grid of u, plus the nominal (off) column.
-struct Profile {
-    u: Vec<f64>,
-    /// [condition][grid point]; the last column is the nominal.
-    chi2: Vec<Vec<f64>>,
-}
-
-impl Profile {
-    fn total(&self, j: usize) -> f64 {
-        self.chi2.iter().map(|c| c[j]).sum()
-    }
-    fn off(&self) -> usize {
-        self.u.len()
-    }
-    /// In-sample optimum over the grid and the nominal.
-    fn best(&self) -> (usize, f64) {
-        let mut best = (self.off(), self.total(self.off()));
-        for j in 0..self.u.len() {
-            let t = self.total(j);
-            if t < best.1 {
-                best = (j, t);
-            }
-        }
-        best
-    }
-    /// Leave-one-condition-out χ²: each condition at the optimum of the others.
-    fn held_out(&self) -> f64 {
-        let npts = self.u.len() + 1;
-        let totals: Vec<f64> = (0..npts).map(|j| self.total(j)).collect();
-        let mut cv = 0.0;
-        for c in &self.chi2 {
-            let mut bj = self.off();
-            let mut bv = totals[bj] - c[bj];
-            for j in 0..self.u.len() {
-                let v = totals[j] - c[j];
-                if v < bv {
-                    bv = v;
-                    bj = j;
-                }
-            }
-            cv += c[bj];
-        }
-        cv
-    }
-}
-
-fn build_profile(
-    curve: &Curve,
-    obs: &[Observation],
-    nominal: &[SimMetrics],
-    n_cond: usize,
-    u_range: (f64, f64),
-) -> Profile {
-    let u: Vec<f64> = (0..FINE_POINTS)
-        .map(|j| u_range.0 + (u_range.1 - u_range.0) * j as f64 / (FINE_POINTS - 1) as f64)
-        .collect();
-    let mut chi2 = vec![vec![0.0; u.len() + 1]; n_cond];
-    for o in obs {
-        let row = &mut chi2[o.trial];
-        for (j, uj) in u.iter().enumerate() {
-            row[j] += o.z2(curve.value(o.trial, o.metric, *uj));
-        }
-        row[u.len()] += o.z2(nominal[o.trial].get(o.metric));
-    }
-    Profile { u, chi2 }
 }
 
 /// Trials whose `trajectory` file is given get the metrics they lack measured from it, by
@@ -484,7 +226,7 @@ fn fill_from_trajectories(
         };
         let samples = crate::sim::read_trajectory_csv(&path)
             .map_err(|e| at(format!("trajectory {}: {e}", path.display())))?;
-        let d = c.design_with(lib, None)?;
+        let d = c.design_with(lib, &super::knob::ModelSetting::nominal())?;
         let report =
             crate::sim::report_from_trajectory(&d, &crate::sim::WalkOptions::default(), &samples)
                 .map_err(|e| at(format!("trajectory {}: {e}", path.display())))?;
@@ -532,34 +274,6 @@ pub fn observations(set: &TrialSet, default_relative_sd: f64) -> (Vec<Observatio
     (obs, notes)
 }
 
-fn chi2_sf(x: f64, df: f64) -> f64 {
-    match ChiSquared::new(df) {
-        Ok(d) if x > 0.0 => d.sf(x),
-        _ => 1.0,
-    }
-}
-
-fn normal_quantile(p: f64) -> f64 {
-    Normal::new(0.0, 1.0)
-        .map(|n| n.inverse_cdf(p))
-        .unwrap_or(f64::NAN)
-}
-
-/// The nondimensional magnitude range and off value of an effect for the first design.
-fn magnitude_domain(def: &EffectDef, cond: &Condition) -> (f64, f64, f64) {
-    let p = def.magnitude();
-    let off = p.off_nondimensional(&cond.design, &def.name);
-    (p.range[0].ln(), p.range[1].ln(), off)
-}
-
-/// Grid of simulated magnitudes (u = ln nondimensional magnitude).
-fn grid(lo: f64, hi: f64, n: usize) -> Vec<f64> {
-    let n = n.max(2);
-    (0..n)
-        .map(|k| lo + (hi - lo) * k as f64 / (n - 1) as f64)
-        .collect()
-}
-
 /// Diagnoses `set` against the simulator.
 pub fn diagnose(
     set: &TrialSet,
@@ -572,15 +286,7 @@ pub fn diagnose(
     diagnose_conditions(set, &conditions, lib, opts, &cache, progress)
 }
 
-/// [`diagnose`] on resolved conditions, sharing walks through `cache`.
-pub fn diagnose_conditions(
-    set: &TrialSet,
-    conditions: &[Condition],
-    lib: &EffectLibrary,
-    opts: &DiagnoseOptions,
-    cache: &SimCache,
-    progress: &(dyn Fn(&str) + Sync),
-) -> Result<(Diagnosis, Timing), GapError> {
+fn check_options(opts: &DiagnoseOptions) -> Result<(), GapError> {
     if !(opts.default_relative_sd > 0.0 && opts.default_relative_sd.is_finite()) {
         return Err(GapError::Invalid(
             "the default relative sd must be finite and > 0".into(),
@@ -592,6 +298,128 @@ pub fn diagnose_conditions(
     if !(2..=64).contains(&opts.grid_points) {
         return Err(GapError::Invalid("grid points must be in [2, 64]".into()));
     }
+    Ok(())
+}
+
+/// Rounds of adaptive refinement of the knobs' curves.
+const CURVE_ROUNDS: usize = 3;
+/// A curve segment is split while, at its midpoint, the monotone cubic and the straight line
+/// between its ends differ by more than this many sds for some observation (the curve bends
+/// there more than the data's resolution), or one end falls and the other walks.
+const CURVE_MAX_BEND_Z: f64 = 1.0;
+/// Only where the curve is within this many sds of the measured value (at either end of
+/// the segment) does its shape matter for the fits.
+const CURVE_REACH_Z: f64 = 10.0;
+/// Most nodes a curve gets.
+const CURVE_MAX_NODES: usize = 21;
+
+/// The surrogate: the nominal walks and every knob's curve — `grid_points` walks over the
+/// knob's range, then midpoints added where a segment bends more than the data resolve
+/// ([`CURVE_MAX_BEND_Z`]) or crosses a fall, all walks of a round in one parallel batch.
+pub fn build_surrogate(
+    conditions: &[Condition],
+    lib: &EffectLibrary,
+    knobs: &Knobs,
+    obs: &[Observation],
+    grid_points: usize,
+    cache: &SimCache,
+    progress: &(dyn Fn(&str) + Sync),
+) -> Result<Surrogate, GapError> {
+    let nominal = cache.get(
+        conditions,
+        lib,
+        &super::knob::ModelSetting::nominal(),
+        &|| progress(""),
+    )?;
+    let setting_at = |k: usize, x: f64| {
+        let mut point = knobs.nominal_point();
+        point[k] = Some(x);
+        knobs.setting(lib, &point)
+    };
+    let mut settings = Vec::new();
+    let mut nodes_of = Vec::new();
+    for (k, knob) in knobs.list.iter().enumerate() {
+        let nodes = knob.nodes(grid_points);
+        settings.extend(nodes.iter().map(|x| setting_at(k, *x)));
+        nodes_of.push(nodes);
+    }
+    let sims = cache.get_many(conditions, lib, &settings, &|| progress(""))?;
+    let mut it = sims.into_iter();
+    let mut curves = Vec::new();
+    for (knob, nodes) in knobs.list.iter().zip(nodes_of) {
+        let s: Vec<_> = (0..nodes.len()).filter_map(|_| it.next()).collect();
+        let mut curve = Curve::new(nodes, s);
+        // A nominal inside the range (a parameter's file value, the design's own μ) is a
+        // walk already made: the nominal one.
+        if let Some(x) = knob.nominal {
+            curve.insert(x, &nominal);
+        }
+        curves.push(curve);
+    }
+    for _ in 0..CURVE_ROUNDS {
+        let mut wanted: Vec<(usize, f64)> = Vec::new();
+        for (k, (knob, curve)) in knobs.list.iter().zip(&curves).enumerate() {
+            let min_gap = (knob.hi - knob.lo) / 64.0;
+            for j in 0..curve.x.len().saturating_sub(1) {
+                if curve.x.len() + wanted.iter().filter(|w| w.0 == k).count() >= CURVE_MAX_NODES {
+                    break;
+                }
+                let (a, b) = (curve.x[j], curve.x[j + 1]);
+                if b - a < 2.0 * min_gap {
+                    continue;
+                }
+                let m = 0.5 * (a + b);
+                let steep = obs.iter().any(|o| {
+                    let (ya, yb) = (
+                        curve.value(o.trial, o.metric, a),
+                        curve.value(o.trial, o.metric, b),
+                    );
+                    match (ya.is_finite(), yb.is_finite()) {
+                        (true, true) => {
+                            let near = ((ya - o.value) / o.sd)
+                                .abs()
+                                .min(((yb - o.value) / o.sd).abs())
+                                < CURVE_REACH_Z;
+                            let bend = curve.value(o.trial, o.metric, m) - 0.5 * (ya + yb);
+                            near && (bend / o.sd).abs() > CURVE_MAX_BEND_Z
+                        }
+                        (false, false) => false,
+                        _ => true,
+                    }
+                });
+                if steep {
+                    wanted.push((k, 0.5 * (a + b)));
+                }
+            }
+        }
+        if wanted.is_empty() {
+            break;
+        }
+        progress("refining the knobs' curves where the gait changes fast");
+        let settings: Vec<_> = wanted.iter().map(|(k, x)| setting_at(*k, *x)).collect();
+        let sims = cache.get_many(conditions, lib, &settings, &|| progress(""))?;
+        for ((k, x), s) in wanted.into_iter().zip(sims) {
+            curves[k].insert(x, &s);
+        }
+    }
+    if std::env::var("GAP_DEBUG").is_ok() {
+        for (k, c) in knobs.list.iter().zip(&curves) {
+            eprintln!("{}: {} nodes", k.label(), c.x.len());
+        }
+    }
+    Ok(Surrogate { nominal, curves })
+}
+
+/// [`diagnose`] on resolved conditions, sharing walks through `cache`.
+pub fn diagnose_conditions(
+    set: &TrialSet,
+    conditions: &[Condition],
+    lib: &EffectLibrary,
+    opts: &DiagnoseOptions,
+    cache: &SimCache,
+    progress: &(dyn Fn(&str) + Sync),
+) -> Result<(Diagnosis, Timing), GapError> {
+    check_options(opts)?;
     let candidates = lib.subset(&opts.effects)?;
     let filled = fill_from_trajectories(set, conditions, lib)?;
     let set = &filled;
@@ -604,224 +432,626 @@ pub fn diagnose_conditions(
                 .into(),
         });
     }
-    let walks0 = cache.walks.load(std::sync::atomic::Ordering::Relaxed);
-    let mut timing = Timing::default();
-    let n = obs.len() as f64;
-    let nc = conditions.len();
-    let first = &conditions[0];
-
-    // Nominal.
-    let t0 = Instant::now();
-    progress("nominal model");
-    let nominal = cache.get(conditions, lib, None, &|| progress(""))?;
-    timing.nominal_s = t0.elapsed().as_secs_f64();
-    let chi2_before: f64 = obs
-        .iter()
-        .map(|o| o.z2(nominal[o.trial].get(o.metric)))
-        .sum();
-    let gap_before = (chi2_before / n).sqrt();
-    let p_value_before = chi2_sf(chi2_before, n);
-    let within_noise = p_value_before >= opts.alpha;
-
-    // Candidate grids, all walks in one parallel batch.
-    let t1 = Instant::now();
-    progress("candidate grids");
-    let mut settings = Vec::new();
-    let mut domains = Vec::new();
-    for def in &candidates {
-        let (lo, hi, off) = magnitude_domain(def, first);
-        domains.push((lo, hi, off));
-        for u in grid(lo, hi, opts.grid_points) {
-            settings.push(Some(def.setting(u.exp())));
+    let mut designs: Vec<&crate::sim::Design> = Vec::new();
+    for c in conditions {
+        if !designs.iter().any(|d| d.name == c.design.name) {
+            designs.push(&c.design);
         }
     }
-    let grid_sims = cache.get_many(conditions, lib, &settings, &|| progress(""))?;
-    let mut curves: Vec<Curve> = Vec::new();
-    let mut it = grid_sims.into_iter();
-    for (lo, hi, off) in &domains {
-        let u = grid(*lo, *hi, opts.grid_points);
-        let sims: Vec<Vec<SimMetrics>> = (0..u.len()).filter_map(|_| it.next()).collect();
-        let mut curve = Curve::new(u, sims);
-        // An off value inside the range (the design's own μ) is a walk already made: the
-        // nominal one, a node of the curve.
-        if *off > 0.0 && off.is_finite() && (*lo..=*hi).contains(&off.ln()) {
-            curve.insert(off.ln(), nominal.clone());
-        }
-        curves.push(curve);
-    }
-    timing.grid_s = t1.elapsed().as_secs_f64();
-
-    // Coarse fits.
-    let t2 = Instant::now();
-    let k = candidates.len() as f64;
-    let lr_critical_p = opts.alpha / k;
-    let mut profiles: Vec<Profile> = curves
-        .iter()
-        .zip(&domains)
-        .map(|(c, d)| build_profile(c, &obs, &nominal, nc, (d.0, d.1)))
-        .collect();
-    let penalty = n.ln() / n;
-    let score_of = |p: &Profile| p.held_out() / n + penalty;
-    timing.fit_s += t2.elapsed().as_secs_f64();
-
-    // Refine the best few: walks at the optimum and at its interval's ends.
-    let t3 = Instant::now();
-    let mut order: Vec<usize> = (0..candidates.len()).collect();
-    let coarse: Vec<f64> = profiles.iter().map(score_of).collect();
-    order.sort_by(|a, b| coarse[*a].total_cmp(&coarse[*b]));
-    let mut refined = vec![false; candidates.len()];
-    for (rank, &ci) in order.iter().enumerate() {
-        if rank >= opts.refine_top.max(1) {
-            break;
-        }
-        if rank > 0 && coarse[ci] > coarse[order[0]] * 2.5 {
-            break;
-        }
-        // Surrogate refinement: walk at the interpolant's optimum and halfway to the nodes
-        // either side, until the optimum sits on a walked node (the interpolant is exact
-        // there) or the rounds run out. The best candidate gets more rounds.
-        let rounds = if rank == 0 { 5 } else { 3 };
-        for _round in 0..rounds {
-            let prof = &profiles[ci];
-            let (j, _) = prof.best();
-            if j == prof.off() {
-                break;
-            }
-            let u_hat = prof.u[j];
-            let nodes = &curves[ci].u;
-            let tol = 2.0 * (domains[ci].1 - domains[ci].0) / (FINE_POINTS - 1) as f64;
-            if nodes.iter().any(|x| (x - u_hat).abs() <= tol) && refined[ci] {
-                break;
-            }
-            let k = nodes.partition_point(|x| *x < u_hat);
-            let mut pts = vec![u_hat];
-            if k > 0 {
-                pts.push(0.5 * (u_hat + nodes[k - 1]));
-            }
-            if k < nodes.len() {
-                pts.push(0.5 * (u_hat + nodes[k]));
-            }
-            let new: Vec<f64> = pts
-                .into_iter()
-                .map(|u| u.clamp(domains[ci].0, domains[ci].1))
-                .filter(|u| !curves[ci].u.iter().any(|x| (x - u).abs() < tol))
-                .collect();
-            if new.is_empty() {
-                break;
-            }
-            progress(&format!("refining {}", candidates[ci].name));
-            let sets: Vec<Option<EffectSetting>> = new
-                .iter()
-                .map(|u| Some(candidates[ci].setting(u.exp())))
-                .collect();
-            let sims = cache.get_many(conditions, lib, &sets, &|| progress(""))?;
-            for (u, s) in new.into_iter().zip(sims) {
-                curves[ci].insert(u, s);
-            }
-            profiles[ci] = build_profile(
-                &curves[ci],
-                &obs,
-                &nominal,
-                nc,
-                (domains[ci].0, domains[ci].1),
-            );
-            refined[ci] = true;
-        }
-    }
-    timing.refine_s = t3.elapsed().as_secs_f64();
-
-    // Ranking.
-    let t4 = Instant::now();
-    let mut ranking = Vec::new();
-    for (ci, def) in candidates.iter().enumerate() {
-        let prof = &profiles[ci];
-        let (j, chi_in) = prof.best();
-        let cv = prof.held_out();
-        let lr = (chi2_before - chi_in).max(0.0);
-        let p_value = chi2_sf(lr, 1.0);
-        let gap_after = (cv / n).sqrt();
-        let mag = (j != prof.off()).then(|| prof.u[j].exp());
-        let setting = def.setting(mag.unwrap_or(def.magnitude().default));
-        let mut params = def.si_values(&first.design, &setting.nondimensional);
-        if mag.is_none()
-            && let Some(p) = def.parameters.first()
-        {
-            params.insert(
-                p.name.clone(),
-                p.off_nondimensional(&first.design, &def.name) * p.scale.value(&first.design),
-            );
-        }
-        ranking.push(RankedEffect {
-            effect: def.name.clone(),
-            params,
-            magnitude_nondimensional: mag,
-            gap_after,
-            shrink_pct: 100.0 * (1.0 - gap_after / gap_before),
-            score: cv / n + penalty,
-            gap_after_in_sample: (chi_in / n).sqrt(),
-            lr,
-            p_value,
-            significant: p_value < lr_critical_p && cv < chi2_before && mag.is_some(),
-            refined: refined[ci],
-        });
-    }
-    ranking.sort_by(|a, b| a.score.total_cmp(&b.score));
-
-    // A call must also be material: the corrected model fits within noise, or the gap at
-    // least halves. A significant but small improvement (a real gap that stays real) is
-    // reported in the ranking and the verdict, not called.
-    let material = |r: &RankedEffect| {
-        let chi_in = r.gap_after_in_sample.powi(2) * n;
-        chi2_sf(chi_in, (n - 1.0).max(1.0)) >= opts.alpha || r.shrink_pct >= 50.0
-    };
-    let best_idx = ranking.iter().position(|r| r.significant && material(r));
-    let partial = ranking
-        .iter()
-        .find(|r| r.significant && !material(r))
-        .map(|r| (r.effect.clone(), r.shrink_pct, r.gap_after));
-    let mut best = None;
-    let mut after: Option<(usize, f64)> = None;
-    if let Some(bi) = best_idx {
-        let r = &ranking[bi];
-        let ci = candidates
-            .iter()
-            .position(|d| d.name == r.effect)
-            .unwrap_or(0);
-        let prof = &profiles[ci];
-        let (j, chi_min) = prof.best();
-        let def = candidates[ci];
-        let (lo_u, hi_u) = profile_interval(prof, j, chi_min, n).unwrap_or((prof.u[j], prof.u[j]));
-        let scale = def.magnitude().scale.value(&first.design);
-        let mag = prof.u[j].exp();
-        let mut params_ci = std::collections::BTreeMap::new();
-        params_ci.insert(
-            def.magnitude().name.clone(),
-            [lo_u.exp() * scale, hi_u.exp() * scale],
+    let knobs = Knobs::build(&designs, &candidates, opts.calibrate).map_err(|e| GapError::Sim {
+        origin: set.origin.clone(),
+        source: e,
+    })?;
+    if opts.calibrate && !knobs.list.iter().any(|k| k.kind == KnobKind::Parameter) {
+        notes.push(
+            "no design of these trials declares [[uncertain]] parameters: the nominal model is \
+             taken as right (only effects are candidates)"
+                .into(),
         );
-        let edge = (lo_u - domains[ci].0).abs() < 1e-9 || (hi_u - domains[ci].1).abs() < 1e-9;
-        best = Some(BestEffect {
-            effect: r.effect.clone(),
-            params: r.params.clone(),
-            params_ci,
-            magnitude_nondimensional: mag,
-            magnitude_ci_nondimensional: [lo_u.exp(), hi_u.exp()],
-            gap_after: r.gap_after,
-            shrink_pct: r.shrink_pct,
-            gap_after_in_sample: r.gap_after_in_sample,
-            ci_at_range_edge: edge,
-        });
-        after = Some((ci, prof.u[j]));
     }
+    for (e, p) in &knobs.aliased {
+        notes.push(format!(
+            "{e} is not tested as an effect: the design declares {p} uncertain, and calibrating \
+             it is the same physics"
+        ));
+    }
+    let walks0 = cache.walks();
+    let mut timing = Timing::default();
+    let n = obs.len();
 
-    // Residuals before/after.
-    let mut residuals = Vec::new();
-    for o in &obs {
+    let t0 = Instant::now();
+    progress("walking every knob over its range");
+    let surrogate = build_surrogate(
+        conditions,
+        lib,
+        &knobs,
+        &obs,
+        opts.grid_points,
+        cache,
+        progress,
+    )?;
+    timing.grid_s = t0.elapsed().as_secs_f64();
+    let surrogate = std::sync::RwLock::new(surrogate);
+    let ctx = FitContext {
+        conditions,
+        lib,
+        cache,
+        knobs: &knobs,
+        surrogate: &surrogate,
+        obs: &obs,
+        progress,
+    };
+    let nominal = ctx.nominal()?;
+    let chi2_before = nominal.chi2_data;
+    let gap_before = (chi2_before / n as f64).sqrt();
+    let p_value_before = chi2_upper_p(chi2_before, n as f64).unwrap_or(1.0);
+    let nominal_within_noise = p_value_before >= opts.alpha;
+
+    let t1 = Instant::now();
+    let sel_opts = SelectOptions {
+        alpha: opts.alpha,
+        always_recalibrate: opts.explanations,
+        ..opts.select.clone()
+    };
+    let groups = groupings(conditions);
+    let labels: Vec<String> = set
+        .trials
+        .iter()
+        .map(|t| {
+            if t.label.is_empty() {
+                format!("line {}", t.line)
+            } else {
+                t.label.clone()
+            }
+        })
+        .collect();
+    let selection = select(&ctx, &sel_opts, &nominal, &groups, &labels)?;
+    timing.select_s = t1.elapsed().as_secs_f64();
+
+    let t2 = Instant::now();
+    progress("intervals and competing explanations");
+    let single = single_fits(&ctx, &nominal, &selection.singles);
+    let final_fit = if selection.final_fit.active.is_empty() {
+        selection.final_fit.clone()
+    } else {
+        progress("polishing the answer with walks");
+        ctx.polish(&selection.final_fit)?
+    };
+    let (explanations, calibration) = if opts.explanations {
+        (
+            explanations(&ctx, &nominal, &selection, &final_fit, &single, opts.alpha)?,
+            match &selection.recalibration {
+                Some(r) => calibrated(&ctx, r),
+                None => Vec::new(),
+            },
+        )
+    } else {
+        (Vec::new(), Vec::new())
+    };
+    let final_fit = &final_fit;
+    let answer = answer(
+        &ctx,
+        &selection.steps,
+        final_fit,
+        nominal_within_noise,
+        opts.alpha,
+        set,
+    )?;
+    notes.extend(selection.notes.iter().cloned());
+    notes.dedup();
+    let residuals = residuals(set, conditions, &obs, &nominal, final_fit)?;
+    let where_ = metric_gaps(&residuals, opts.alpha);
+    let summary = summarize(&where_, nominal_within_noise);
+    let identifiability = if opts.identifiability {
+        let k = knobs
+            .list
+            .iter()
+            .filter(|k| k.kind == KnobKind::Effect)
+            .count()
+            .max(1) as f64;
+        progress("identifiability thresholds");
+        identifiability(&ctx, opts.alpha / k, &|name: &str| match lib.get(name) {
+            Ok(def) => (def.magnitude().name.clone(), def.magnitude().unit.clone()),
+            Err(_) => (String::new(), String::new()),
+        })?
+    } else {
+        Vec::new()
+    };
+    if obs.iter().any(|o| o.sd_assumed) {
+        notes.push(format!(
+            "{} of {} measurements state no sd: {} % of the value assumed",
+            obs.iter().filter(|o| o.sd_assumed).count(),
+            obs.len(),
+            opts.default_relative_sd * 100.0
+        ));
+    }
+    timing.report_s = t2.elapsed().as_secs_f64();
+    let walks = cache.walks() - walks0;
+    timing.walks = walks;
+    timing.nominal_s = 0.0;
+    Ok((
+        Diagnosis {
+            trials: set.origin.clone(),
+            n_trials: set.trials.len(),
+            n_observations: n,
+            gap_before,
+            chi2_before,
+            p_value_before,
+            within_noise: nominal_within_noise,
+            summary,
+            where_,
+            answer,
+            chain: selection.steps.clone(),
+            explanations,
+            calibration,
+            single,
+            identifiability,
+            aliased: knobs.aliased.clone(),
+            notes,
+            residuals,
+            walks_evaluated: walks,
+        },
+        timing,
+    ))
+}
+
+/// Every knob alone, fitted from the nominal on the surrogate, held-out gap and LR test.
+fn single_fits(ctx: &FitContext<'_>, nominal: &Fit, singles: &[(usize, Fit)]) -> Vec<SingleFit> {
+    let n = ctx.n();
+    let gap0 = gap_of(nominal, n);
+    let mut out: Vec<SingleFit> = singles
+        .iter()
+        .map(|(k, f)| {
+            let knob = &ctx.knobs.list[*k];
+            let lr = nominal.chi2 - f.chi2;
+            let phi = dispersion(f.chi2_data, n, 1);
+            let gap = gap_of(f, n);
+            SingleFit {
+                knob: knob.label(),
+                kind: knob.kind,
+                value: f.point[*k].map(|x| knob.si(x)).unwrap_or(f64::NAN),
+                unit: knob.unit.clone(),
+                gap_held_out: gap,
+                shrink_pct: 100.0 * (1.0 - gap / gap0),
+                lr,
+                p_value: lr_p_value(lr, 1, phi, n.saturating_sub(1)),
+            }
+        })
+        .collect();
+    out.sort_by(|a, b| a.gap_held_out.total_cmp(&b.gap_held_out));
+    out
+}
+
+fn explanation(
+    ctx: &FitContext<'_>,
+    model: &str,
+    fit: &Fit,
+    nominal: &Fit,
+    alpha: f64,
+) -> Explanation {
+    let n = ctx.n();
+    let gap0 = gap_of(nominal, n);
+    let gap = gap_of(fit, n);
+    let k = fit.k();
+    let lr = nominal.chi2 - fit.chi2;
+    let phi = dispersion(fit.chi2_data, n, k);
+    Explanation {
+        model: model.into(),
+        knobs: fit
+            .active
+            .iter()
+            .filter_map(|i| {
+                fit.point[*i].map(|x| (ctx.knobs.list[*i].label(), ctx.knobs.list[*i].si(x)))
+            })
+            .collect(),
+        free: k,
+        chi2: fit.chi2,
+        gap_held_out: gap,
+        shrink_pct: 100.0 * (1.0 - gap / gap0),
+        p_vs_nominal: (k > 0).then(|| lr_p_value(lr, k, phi, n.saturating_sub(k))),
+        within_noise: within_noise(fit, n, alpha),
+    }
+}
+
+/// The competing explanations side by side, each confirmed with walks: the nominal, the
+/// recalibrated parameters, the best effect alone, the best effect with the recalibration,
+/// the chain's model.
+fn explanations(
+    ctx: &FitContext<'_>,
+    nominal: &Fit,
+    selection: &super::select::Selection,
+    final_fit: &Fit,
+    single: &[SingleFit],
+    alpha: f64,
+) -> Result<Vec<Explanation>, GapError> {
+    let mut out = vec![explanation(ctx, "nominal", nominal, nominal, alpha)];
+    if let Some(r) = &selection.recalibration {
+        out.push(explanation(
+            ctx,
+            "parameters off (every uncertain parameter recalibrated)",
+            r,
+            nominal,
+            alpha,
+        ));
+    }
+    let best_effect = single
+        .iter()
+        .find(|s| s.kind == KnobKind::Effect)
+        .and_then(|s| ctx.knobs.index_of(&s.knob));
+    if let Some(e) = best_effect {
+        let starts = ctx.starts_adding(nominal, e);
+        let f = ctx.with_held_out(ctx.fit_walked(&[e], &starts, None, Some(nominal))?);
+        out.push(explanation(
+            ctx,
+            &format!(
+                "effect alone ({}; parameters nominal)",
+                ctx.knobs.list[e].label()
+            ),
+            &f,
+            nominal,
+            alpha,
+        ));
+        if let Some(r) = &selection.recalibration {
+            let mut active = r.active.clone();
+            active.push(e);
+            let starts = ctx.starts_adding(r, e);
+            let f = ctx.with_held_out(ctx.fit_walked(&active, &starts, None, Some(r))?);
+            out.push(explanation(
+                ctx,
+                &format!(
+                    "effect with the parameters recalibrated ({} + every uncertain parameter)",
+                    ctx.knobs.list[e].label()
+                ),
+                &f,
+                nominal,
+                alpha,
+            ));
+        }
+    }
+    if !selection.steps.is_empty() {
+        out.push(explanation(
+            ctx,
+            "the chain (the answer)",
+            final_fit,
+            nominal,
+            alpha,
+        ));
+    }
+    Ok(out)
+}
+
+/// The recalibration's parameters: value, profile interval, move in prior sds, and how much
+/// of its range the interval still spans.
+fn calibrated(ctx: &FitContext<'_>, r: &Fit) -> Vec<Calibrated> {
+    let n = ctx.n();
+    let phi = dispersion(r.chi2_data, n, r.k());
+    let phi = if phi.is_finite() { phi } else { 1.0 };
+    r.active
+        .iter()
+        .map(|&k| {
+            let knob = &ctx.knobs.list[k];
+            let x = r.point[k].unwrap_or(knob.lo);
+            let iv = ctx.profile(r, k, phi).unwrap_or(ProfileInterval {
+                lo: knob.lo,
+                hi: knob.hi,
+                open_below: true,
+                open_above: true,
+            });
+            let nominal = knob.nominal.map(|x| knob.value(x)).unwrap_or(f64::NAN);
+            Calibrated {
+                parameter: knob.label(),
+                nominal,
+                value: knob.value(x),
+                interval: [knob.value(iv.lo), knob.value(iv.hi)],
+                range: [knob.value(knob.lo), knob.value(knob.hi)],
+                move_in_sd: knob.prior.map(|(m, sd)| (knob.value(x) - m) / sd),
+                width_of_range: (iv.hi - iv.lo) / (knob.hi - knob.lo),
+                why: knob.why.clone(),
+            }
+        })
+        .collect()
+}
+
+/// The answer: the chain's knobs with their intervals, the final model's residual check,
+/// and the kind.
+fn answer(
+    ctx: &FitContext<'_>,
+    steps: &[Step],
+    final_fit: &Fit,
+    nominal_within_noise: bool,
+    alpha: f64,
+    set: &TrialSet,
+) -> Result<Answer, GapError> {
+    let n = ctx.n();
+    // Intervals and the residual check count the simulator's resolution at the answer as
+    // an error of its own, beside the measurement's: where the gait is knife-edge the data
+    // cannot pin a knob closer than a nudge that changes the gait.
+    let resolution = ctx.resolution(final_fit)?;
+    let inflated: Vec<Observation> = ctx
+        .obs
+        .iter()
+        .map(|o| Observation {
+            sd: o.sd.hypot(resolution[o.trial][o.metric.index()]),
+            ..*o
+        })
+        .collect();
+    let rctx = FitContext {
+        obs: &inflated,
+        ..*ctx
+    };
+    let final_fit = &{
+        let sims = final_fit.sims.clone().unwrap_or_default();
+        let (data, per) = super::problem::chi2_of(&inflated, &sims);
+        Fit {
+            chi2: data + ctx.knobs.prior_chi2(&final_fit.point),
+            chi2_data: data,
+            per_condition: per,
+            ..final_fit.clone()
+        }
+    };
+    let ctx = &rctx;
+    let phi = dispersion(final_fit.chi2_data, n, final_fit.k());
+    let phi = if phi.is_finite() { phi } else { 1.0 };
+    let mut parameters = Vec::new();
+    let mut effects = Vec::new();
+    let mut ambiguous: Vec<Vec<String>> = Vec::new();
+    for step in steps {
+        let Some(k) = ctx.knobs.index_of(&step.knob) else {
+            continue;
+        };
+        let knob = &ctx.knobs.list[k];
+        let x = final_fit.point[k].unwrap_or(knob.lo);
+        let iv = ctx.profile_walked(final_fit, k, phi)?;
+        let (lo, hi, open) = match iv {
+            Some(i) => (i.lo, i.hi, i.open_below || i.open_above),
+            None => (x, x, false),
+        };
+        let nominal = match knob.kind {
+            KnobKind::Parameter => knob.nominal.map(|x| knob.si(x)),
+            KnobKind::Effect => None,
+        };
+        let named = Named {
+            knob: knob.label(),
+            kind: knob.kind,
+            value: knob.si(x),
+            interval: [knob.si(lo), knob.si(hi)],
+            interval_open: open,
+            nominal,
+            change_pct: nominal
+                .filter(|v| *v != 0.0)
+                .map(|v| 100.0 * (knob.si(x) / v - 1.0)),
+            unit: knob.unit.clone(),
+            not_separable_from: step.not_separable_from.clone(),
+        };
+        if !step.not_separable_from.is_empty() {
+            let mut group = vec![knob.label()];
+            group.extend(step.not_separable_from.iter().cloned());
+            ambiguous.push(group);
+            continue;
+        }
+        match knob.kind {
+            KnobKind::Parameter => parameters.push(named),
+            KnobKind::Effect => effects.push(named),
+        }
+    }
+    let fits = within_noise(final_fit, n, alpha);
+    // Names only for a model that fits: knobs of a chain that leaves the rest beyond noise
+    // are leads (shown, with their shrink), not findings — a look-alike that explains part
+    // of a gap it did not cause is exactly what an open world produces.
+    let mut leads = Vec::new();
+    if !fits {
+        leads.append(&mut parameters);
+        leads.append(&mut effects);
+    }
+    let kind = match (leads.is_empty(), parameters.is_empty(), effects.is_empty()) {
+        _ if steps.is_empty() && nominal_within_noise => AnswerKind::WithinNoise,
+        (false, _, _) => AnswerKind::PartlyExplained,
+        (true, true, true) if !ambiguous.is_empty() => AnswerKind::Ambiguous,
+        (true, true, true) if nominal_within_noise => AnswerKind::WithinNoise,
+        (true, true, true) => AnswerKind::Unexplained,
+        (true, false, true) => AnswerKind::ParametersOff,
+        (true, true, false) => AnswerKind::EffectMissing,
+        (true, false, false) => AnswerKind::Both,
+    };
+    let rest = (!fits && kind != AnswerKind::WithinNoise)
+        .then(|| rest_of(ctx, final_fit, alpha, set))
+        .flatten();
+    let statement = statement(
+        kind,
+        &parameters,
+        &effects,
+        &leads,
+        &ambiguous,
+        steps,
+        rest.as_deref(),
+    );
+    Ok(Answer {
+        kind,
+        parameters,
+        effects,
+        leads,
+        ambiguous,
+        rest,
+        statement,
+    })
+}
+
+/// Where a model's remaining misfit lies: the metrics beyond noise and their worst trials.
+fn rest_of(ctx: &FitContext<'_>, fit: &Fit, alpha: f64, set: &TrialSet) -> Option<String> {
+    let sims = fit.sims.as_ref()?;
+    let mut parts = Vec::new();
+    for m in Metric::SIMULATED {
+        let z: Vec<(usize, f64)> = ctx
+            .obs
+            .iter()
+            .filter(|o| o.metric == m)
+            .map(|o| (o.trial, o.z2(sims[o.trial].get(m))))
+            .collect();
+        if z.is_empty() {
+            continue;
+        }
+        let chi2: f64 = z.iter().map(|(_, v)| v).sum();
+        let p = chi2_upper_p(chi2, z.len() as f64).unwrap_or(1.0);
+        if p >= alpha {
+            continue;
+        }
+        let mut worst = z.clone();
+        worst.sort_by(|a, b| b.1.total_cmp(&a.1));
+        let labels: Vec<String> = worst
+            .iter()
+            .take(3)
+            .filter(|(_, v)| *v > 4.0)
+            .map(|(t, v)| {
+                let tr = &set.trials[*t];
+                let label = if tr.label.is_empty() {
+                    format!("line {}", tr.line)
+                } else {
+                    tr.label.clone()
+                };
+                format!("{label} (|z| {:.1})", v.sqrt())
+            })
+            .collect();
+        parts.push(format!(
+            "{} (RMS z {:.1}{}{})",
+            m.words(),
+            (chi2 / z.len() as f64).sqrt(),
+            if labels.is_empty() { "" } else { "; worst at " },
+            labels.join(", ")
+        ));
+    }
+    (!parts.is_empty()).then(|| parts.join("; "))
+}
+
+fn named_text(n: &Named) -> String {
+    let v = super::locate::sig3(n.value);
+    let iv = format!(
+        "[{}, {}]{}",
+        super::locate::sig3(n.interval[0]),
+        super::locate::sig3(n.interval[1]),
+        if n.interval_open {
+            ", open at a range end"
+        } else {
+            ""
+        }
+    );
+    let change = n
+        .change_pct
+        .map(|c| {
+            format!(
+                " ({c:+.0} % of the file's {})",
+                super::locate::sig3(n.nominal.unwrap_or(0.0))
+            )
+        })
+        .unwrap_or_default();
+    let alt = if n.not_separable_from.is_empty() {
+        String::new()
+    } else {
+        format!(
+            "; these trials cannot tell it from {}",
+            n.not_separable_from.join(", ")
+        )
+    };
+    format!("{} = {v} {}{change} {iv}{alt}", n.knob, n.unit).replace("  ", " ")
+}
+
+fn statement(
+    kind: AnswerKind,
+    parameters: &[Named],
+    effects: &[Named],
+    leads: &[Named],
+    ambiguous: &[Vec<String>],
+    steps: &[Step],
+    rest: Option<&str>,
+) -> String {
+    let chain: Vec<String> = steps
+        .iter()
+        .enumerate()
+        .map(|(i, s)| {
+            format!(
+                "{}{}: −{:.0} %",
+                if i > 0 { "+ " } else { "" },
+                s.knob,
+                s.shrink_pct
+            )
+        })
+        .collect();
+    let list = |v: &[Named]| v.iter().map(named_text).collect::<Vec<_>>().join("; ");
+    let undecided = if ambiguous.is_empty() {
+        String::new()
+    } else {
+        format!(
+            "; not told apart by these trials: {}",
+            ambiguous
+                .iter()
+                .map(|g| format!("one of {{{}}}", g.join(", ")))
+                .collect::<Vec<_>>()
+                .join(", ")
+        )
+    };
+    let s = match kind {
+        AnswerKind::WithinNoise => {
+            "no significant gap: the nominal model fits within the stated noise".into()
+        }
+        AnswerKind::Unexplained => "unexplained: the gap is real, and neither a recalibration of \
+             the design's uncertain parameters nor an effect of the library explains it under \
+             the call rules (a model error outside the declared parameters, or an effect outside \
+             the library)"
+            .into(),
+        AnswerKind::ParametersOff => format!(
+            "parameters off: {} (chain {}; the rest within noise)",
+            list(parameters),
+            chain.join(", ")
+        ),
+        AnswerKind::EffectMissing => format!(
+            "effect missing: {} (chain {}; the rest within noise)",
+            list(effects),
+            chain.join(", ")
+        ),
+        AnswerKind::Both => format!(
+            "both parameters off and an effect missing: {}; {} (chain {}; the rest within noise)",
+            list(parameters),
+            list(effects),
+            chain.join(", ")
+        ),
+        AnswerKind::PartlyExplained => format!(
+            "partly explained, nothing named: the best chain ({}) leaves the rest beyond noise \
+             in {}; leads, not findings: {}",
+            chain.join(", "),
+            rest.unwrap_or("several metrics"),
+            list(leads)
+        ),
+        AnswerKind::Ambiguous => format!(
+            "ambiguous: the gap is explained (chain {}){}, but no knob is named",
+            chain.join(", "),
+            if rest.is_some() { " only in part" } else { "" }
+        ),
+    };
+    format!("{s}{undecided}")
+}
+
+/// Residuals of the nominal model and of the final model.
+fn residuals(
+    set: &TrialSet,
+    conditions: &[Condition],
+    obs: &[Observation],
+    nominal: &Fit,
+    final_fit: &Fit,
+) -> Result<Vec<Residual>, GapError> {
+    let mut out = Vec::new();
+    let nom = nominal.sims.as_deref().unwrap_or(&[]);
+    let after = (!final_fit.active.is_empty())
+        .then_some(final_fit.sims.as_deref())
+        .flatten();
+    for o in obs {
         let c = &conditions[o.trial];
         let t = &set.trials[o.trial];
-        let sim = nominal[o.trial].get(o.metric);
-        let (sa, za) = match after {
-            Some((ci, u)) => {
-                let v = curves[ci].value(o.trial, o.metric, u);
+        let sim = nom
+            .get(o.trial)
+            .map(|s| s.get(o.metric))
+            .unwrap_or(f64::NAN);
+        let (sa, za) = match after.and_then(|a| a.get(o.trial)) {
+            Some(s) => {
+                let v = s.get(o.metric);
                 (
                     v.is_finite().then_some(v),
                     v.is_finite().then(|| (v - o.value) / o.sd),
@@ -829,7 +1059,7 @@ pub fn diagnose_conditions(
             }
             None => (None, None),
         };
-        residuals.push(Residual {
+        out.push(Residual {
             trial: o.trial,
             label: if t.label.is_empty() {
                 format!("line {}", t.line)
@@ -850,441 +1080,5 @@ pub fn diagnose_conditions(
             z_after: za,
         });
     }
-    let where_ = metric_gaps(&residuals, opts.alpha);
-    let summary = summarize(&where_, within_noise);
-    let identifiability = candidates
-        .iter()
-        .enumerate()
-        .map(|(ci, def)| {
-            identifiability(
-                ci,
-                def,
-                &candidates,
-                &curves,
-                &domains,
-                &obs,
-                &nominal,
-                first,
-                lr_critical_p,
-            )
-        })
-        .collect();
-    let mut verdict = verdict(within_noise, &best, &ranking, gap_before, lr_critical_p);
-    if best.is_none()
-        && let Some((e, shrink, after)) = partial
-    {
-        verdict = format!(
-            "the gap (RMS z = {gap_before:.2}) is real and no candidate explains it: the best, \
-             {e}, lowers it significantly but only by {shrink:.0} % (held-out RMS z {after:.2}, \
-             still beyond noise) — a model error or an effect outside the library carries the rest"
-        );
-    }
-    if obs.iter().any(|o| o.sd_assumed) {
-        notes.push(format!(
-            "{} of {} measurements state no sd: {} % of the value assumed",
-            obs.iter().filter(|o| o.sd_assumed).count(),
-            obs.len(),
-            opts.default_relative_sd * 100.0
-        ));
-    }
-    timing.fit_s += t4.elapsed().as_secs_f64();
-    let walks = cache.walks.load(std::sync::atomic::Ordering::Relaxed) - walks0;
-    timing.walks = walks;
-    Ok((
-        Diagnosis {
-            trials: set.origin.clone(),
-            n_trials: set.trials.len(),
-            n_observations: obs.len(),
-            gap_before,
-            chi2_before,
-            p_value_before,
-            within_noise,
-            summary,
-            where_,
-            ranking,
-            best,
-            verdict,
-            identifiability,
-            notes,
-            residuals,
-            walks_evaluated: walks,
-        },
-        timing,
-    ))
-}
-
-/// The 95 % profile interval [u_lo, u_hi] around grid point `j`: Δχ² ≤ χ²₁(0.95)·s²,
-/// s² = max(1, χ²_min/(n − 1)) (an overdispersed fit widens its interval).
-fn profile_interval(p: &Profile, j: usize, chi_min: f64, n: f64) -> Option<(f64, f64)> {
-    if j >= p.u.len() {
-        return None;
-    }
-    let s2 = (chi_min / (n - 1.0).max(1.0)).max(1.0);
-    let limit = chi_min + 3.841_458_820_694_124 * s2;
-    let mut lo = j;
-    while lo > 0 && p.total(lo - 1) <= limit {
-        lo -= 1;
-    }
-    let mut hi = j;
-    while hi + 1 < p.u.len() && p.total(hi + 1) <= limit {
-        hi += 1;
-    }
-    Some((p.u[lo], p.u[hi]))
-}
-
-fn trend(x: &[f64], y: &[f64]) -> Option<Trend> {
-    let distinct = {
-        let mut v: Vec<f64> = x.to_vec();
-        v.sort_by(f64::total_cmp);
-        v.dedup_by(|a, b| (*a - *b).abs() < 1e-9);
-        v.len()
-    };
-    if x.len() < 4 || distinct < 2 {
-        return None;
-    }
-    let f = fit_line(x, y, Method::Ols, 0.95).ok()?;
-    f.b.is_finite().then_some(Trend {
-        slope: f.b,
-        se: f.se_b,
-        p_value: f.p_b_equals_0,
-    })
-}
-
-fn metric_gaps(res: &[Residual], alpha: f64) -> Vec<MetricGap> {
-    let mut out = Vec::new();
-    for m in Metric::ALL {
-        let rs: Vec<&Residual> = res.iter().filter(|r| r.metric == m).collect();
-        if rs.is_empty() {
-            continue;
-        }
-        let z2: Vec<f64> = rs
-            .iter()
-            .map(|r| r.z.map(|z| z * z).unwrap_or(FELL_Z2))
-            .collect();
-        let chi2: f64 = z2.iter().sum();
-        let nn = rs.len() as f64;
-        let p_value = chi2_sf(chi2, nn);
-        let rel: Vec<f64> = rs.iter().filter_map(|r| r.relative).collect();
-        let mean_rel = if rel.is_empty() {
-            f64::NAN
-        } else {
-            rel.iter().sum::<f64>() / rel.len() as f64
-        };
-        let ls: Vec<f64> = rs.iter().map(|r| r.leg_length_m).collect();
-        let (lmin, lmax) = ls
-            .iter()
-            .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| {
-                (a.min(*v), b.max(*v))
-            });
-        let with_rel: Vec<&&Residual> = rs.iter().filter(|r| r.relative.is_some()).collect();
-        let y: Vec<f64> = with_rel.iter().filter_map(|r| r.relative).collect();
-        let xl: Vec<f64> = with_rel.iter().map(|r| r.leg_length_m.ln()).collect();
-        let xf: Vec<f64> = with_rel.iter().map(|r| r.frequency_hz.ln()).collect();
-        let after: Vec<f64> = rs.iter().filter_map(|r| r.z_after).collect();
-        let rms_after = (after.len() == rs.len() && !after.is_empty())
-            .then(|| (after.iter().map(|z| z * z).sum::<f64>() / nn).sqrt());
-        let significant = p_value < alpha;
-        let mut keys: Vec<(String, String)> = rs
-            .iter()
-            .map(|r| (r.design.clone(), sig3(r.leg_length_m)))
-            .collect();
-        keys.sort();
-        keys.dedup();
-        let regimes: Vec<RegimeGap> = keys
-            .iter()
-            .map(|(dn, lk)| {
-                let g: Vec<&&Residual> = rs
-                    .iter()
-                    .filter(|r| &r.design == dn && &sig3(r.leg_length_m) == lk)
-                    .collect();
-                let c2: f64 = g
-                    .iter()
-                    .map(|r| r.z.map(|z| z * z).unwrap_or(FELL_Z2))
-                    .sum();
-                let rel: Vec<f64> = g.iter().filter_map(|r| r.relative).collect();
-                let p = chi2_sf(c2, g.len() as f64);
-                RegimeGap {
-                    design: dn.clone(),
-                    leg_length_m: g[0].leg_length_m,
-                    n: g.len(),
-                    rms_z: (c2 / g.len() as f64).sqrt(),
-                    mean_relative_pct: 100.0 * rel.iter().sum::<f64>() / rel.len().max(1) as f64,
-                    p_value: p,
-                    significant: p < alpha,
-                }
-            })
-            .collect();
-        let place = if (lmax / lmin - 1.0).abs() < 0.05 {
-            format!("at L ≈ {} m", sig3(lmin))
-        } else {
-            format!("over L = {}–{} m", sig3(lmin), sig3(lmax))
-        };
-        let hot: Vec<&RegimeGap> = regimes.iter().filter(|g| g.significant).collect();
-        let same_sign = (hot.iter().all(|g| g.mean_relative_pct < 0.0)
-            || hot.iter().all(|g| g.mean_relative_pct >= 0.0))
-            && regimes.iter().all(|g| g.design == regimes[0].design);
-        let statement = if significant
-            && regimes.len() > 1
-            && !hot.is_empty()
-            && !(hot.len() == regimes.len() && same_sign)
-        {
-            // Say where: the regimes that carry it.
-            let parts: Vec<String> = hot
-                .iter()
-                .map(|g| {
-                    format!(
-                        "{}-predicted by {:.0} % at L ≈ {} m ({})",
-                        if g.mean_relative_pct < 0.0 {
-                            "under"
-                        } else {
-                            "over"
-                        },
-                        g.mean_relative_pct.abs(),
-                        sig3(g.leg_length_m),
-                        g.design
-                    )
-                })
-                .collect();
-            let rest = if hot.len() < regimes.len() {
-                ", within noise elsewhere"
-            } else {
-                ""
-            };
-            format!("{} {}{rest}", m.words(), parts.join(" and "))
-        } else if significant && mean_rel.is_finite() {
-            format!(
-                "{} {}-predicted by {:.0} % {}",
-                m.words(),
-                if mean_rel < 0.0 { "under" } else { "over" },
-                mean_rel.abs() * 100.0,
-                place
-            )
-        } else if significant {
-            format!("{} missed {} (the simulation falls)", m.words(), place)
-        } else {
-            format!("{} within noise", m.words())
-        };
-        out.push(MetricGap {
-            metric: m,
-            n: rs.len(),
-            rms_z: (chi2 / nn).sqrt(),
-            mean_relative_pct: mean_rel * 100.0,
-            chi2,
-            p_value,
-            significant,
-            leg_lengths_m: [lmin, lmax],
-            trend_with_leg_length: trend(&xl, &y),
-            trend_with_frequency: trend(&xf, &y),
-            rms_z_after: rms_after,
-            regimes,
-            statement,
-        });
-    }
-    out
-}
-
-/// Three significant digits, no trailing zeros.
-fn sig3(v: f64) -> String {
-    if v == 0.0 || !v.is_finite() {
-        return format!("{v}");
-    }
-    let digits = (2 - v.abs().log10().floor() as i32).max(0) as usize;
-    let s = format!("{v:.digits$}");
-    if s.contains('.') {
-        s.trim_end_matches('0').trim_end_matches('.').to_string()
-    } else {
-        s
-    }
-}
-
-fn summarize(gaps: &[MetricGap], within_noise: bool) -> String {
-    let mut parts: Vec<String> = gaps
-        .iter()
-        .filter(|g| g.significant)
-        .map(|g| {
-            let mut s = g.statement.clone();
-            for (t, what) in [
-                (&g.trend_with_leg_length, "leg length"),
-                (&g.trend_with_frequency, "drive frequency"),
-            ] {
-                if let Some(t) = t
-                    && t.p_value < 0.01
-                {
-                    s.push_str(&format!(
-                        " (the relative miss changes by {:+.0} points per doubling of {what})",
-                        t.slope * std::f64::consts::LN_2 * 100.0
-                    ));
-                }
-            }
-            s
-        })
-        .collect();
-    let quiet: Vec<&str> = gaps
-        .iter()
-        .filter(|g| !g.significant)
-        .map(|g| g.metric.words())
-        .collect();
-    if !quiet.is_empty() {
-        parts.push(format!("{} within noise", quiet.join(", ")));
-    }
-    if within_noise && gaps.iter().all(|g| !g.significant) {
-        return format!("no significant gap: {}", parts.join("; "));
-    }
-    parts.join("; ")
-}
-
-fn verdict(
-    within_noise: bool,
-    best: &Option<BestEffect>,
-    ranking: &[RankedEffect],
-    gap_before: f64,
-    p_crit: f64,
-) -> String {
-    match best {
-        Some(b) => format!(
-            "{} explains the gap: held-out gap {:.2} → {:.2} ({:.0} % smaller)",
-            b.effect, gap_before, b.gap_after, b.shrink_pct
-        ),
-        None if within_noise && ranking.iter().all(|r| !r.significant) => format!(
-            "no significant gap (RMS z = {gap_before:.2}, consistent with the stated noise); \
-             no effect is called"
-        ),
-        None => {
-            let top = ranking.first();
-            format!(
-                "the gap (RMS z = {gap_before:.2}) is real but no candidate explains it \
-                 significantly (best: {}, held-out gap {:.2}, p = {:.2e} vs {:.1e} needed): \
-                 a model error or an effect outside the library",
-                top.map(|t| t.effect.as_str()).unwrap_or("none"),
-                top.map(|t| t.gap_after).unwrap_or(f64::NAN),
-                top.map(|t| t.p_value).unwrap_or(1.0),
-                p_crit
-            )
-        }
-    }
-}
-
-/// Noncentrality of a magnitude: how far its predictions sit from a reference, in sd units.
-fn distance2(
-    obs: &[Observation],
-    a: &dyn Fn(usize, Metric) -> f64,
-    b: &dyn Fn(usize, Metric) -> f64,
-    per_metric: Option<&mut [f64; 8]>,
-) -> f64 {
-    let mut total = 0.0;
-    let mut pm = [0.0; 8];
-    for o in obs {
-        let (x, y) = (a(o.trial, o.metric), b(o.trial, o.metric));
-        let d2 = if x.is_finite() && y.is_finite() {
-            ((x - y) / o.sd).powi(2)
-        } else if x.is_finite() != y.is_finite() {
-            FELL_Z2
-        } else {
-            0.0
-        };
-        total += d2;
-        pm[o.metric.index()] += d2;
-    }
-    if let Some(p) = per_metric {
-        *p = pm;
-    }
-    total
-}
-
-#[allow(clippy::too_many_arguments)]
-fn identifiability(
-    ci: usize,
-    def: &EffectDef,
-    candidates: &[&EffectDef],
-    curves: &[Curve],
-    domains: &[(f64, f64, f64)],
-    obs: &[Observation],
-    nominal: &[SimMetrics],
-    first: &Condition,
-    p_crit: f64,
-) -> Identifiability {
-    // Detection with 90 % power by the one-sided LR test at level p_crit.
-    let z = normal_quantile(1.0 - p_crit / 2.0) + normal_quantile(0.9);
-    let lambda_detect = z * z;
-    let z_id = 2.0 * normal_quantile(0.9);
-    let lambda_id = z_id * z_id;
-    let (lo, hi, off) = domains[ci];
-    // Walk outward from the nominal: for off = 0 upward in u, for off = inf downward, for
-    // an off inside the range (μ) toward the lower end ("slip").
-    let steps = 200;
-    let path: Vec<f64> = if off == 0.0 || (off.is_finite() && off.ln() > hi) {
-        (0..=steps)
-            .map(|k| lo + (hi - lo) * k as f64 / steps as f64)
-            .collect()
-    } else if off.is_infinite() || off.ln() >= lo {
-        let start = if off.is_finite() {
-            off.ln().min(hi)
-        } else {
-            hi
-        };
-        (0..=steps)
-            .map(|k| start - (start - lo) * k as f64 / steps as f64)
-            .collect()
-    } else {
-        (0..=steps)
-            .map(|k| hi - (hi - lo) * k as f64 / steps as f64)
-            .collect()
-    };
-    let nominal_of = |i: usize, m: Metric| nominal[i].get(m);
-    let scale = def.magnitude().scale.value(&first.design);
-    let mut detection = None;
-    let mut identification = None;
-    let mut mimic = None;
-    let mut shares = [0.0; 8];
-    for &u in &path {
-        let own = |i: usize, m: Metric| curves[ci].value(i, m, u);
-        let mut pm = [0.0; 8];
-        let lam = distance2(obs, &own, &nominal_of, Some(&mut pm));
-        if detection.is_none() && lam >= lambda_detect {
-            detection = Some(u);
-            shares = pm;
-        }
-        if detection.is_some() && identification.is_none() {
-            // The best mimic: the other candidate's magnitude closest to these predictions.
-            let mut closest = (f64::INFINITY, None);
-            for (cj, other) in curves.iter().enumerate() {
-                if cj == ci {
-                    continue;
-                }
-                let (olo, ohi, _) = domains[cj];
-                for k in 0..=60 {
-                    let uo = olo + (ohi - olo) * k as f64 / 60.0;
-                    let theirs = |i: usize, m: Metric| other.value(i, m, uo);
-                    let d = distance2(obs, &own, &theirs, None);
-                    if d < closest.0 {
-                        closest = (d, Some(candidates[cj].name.clone()));
-                    }
-                }
-            }
-            if closest.0 >= lambda_id {
-                identification = Some(u);
-                mimic = closest.1;
-            }
-        }
-    }
-    if detection.is_none() {
-        let u = *path.last().unwrap_or(&hi);
-        let own = |i: usize, m: Metric| curves[ci].value(i, m, u);
-        distance2(obs, &own, &nominal_of, Some(&mut shares));
-    }
-    let total: f64 = shares.iter().sum();
-    let identifiable_from = Metric::ALL
-        .iter()
-        .filter(|m| total > 0.0 && shares[m.index()] >= 0.1 * total)
-        .copied()
-        .collect();
-    Identifiability {
-        effect: def.name.clone(),
-        parameter: def.magnitude().name.clone(),
-        unit: def.magnitude().unit.clone(),
-        detection_threshold: detection.map(|u| u.exp() * scale),
-        identification_threshold: identification.map(|u| u.exp() * scale),
-        closest_mimic: mimic,
-        identifiable_from,
-    }
+    Ok(out)
 }

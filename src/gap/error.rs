@@ -28,4 +28,6 @@ pub enum GapError {
     Sim { origin: String, source: SimError },
     #[error("{0}")]
     Invalid(String),
+    #[error(transparent)]
+    Checkpoint(#[from] crate::checkpoint::CheckpointError),
 }

@@ -100,6 +100,11 @@ pub struct EffectDef {
     pub description: String,
     pub models: String,
     pub scaling: String,
+    /// The design field this effect replaces, when the effect *is* a design value being
+    /// different (friction_coefficient: `contact.friction_mu`). A design that declares that
+    /// field uncertain calibrates it instead of testing the effect (the same physics).
+    #[serde(default)]
+    pub replaces: Option<String>,
     pub parameters: Vec<ParamDef>,
 }
 
@@ -275,6 +280,11 @@ impl EffectDef {
         }
         // Every default must build a valid simulator term: the names match EffectSpec's.
         let probe = Design::builtin("mugatu").map_err(|e| bad(e.to_string()))?;
+        if let Some(field) = &self.replaces {
+            probe
+                .value_at(field)
+                .map_err(|e| bad(format!("replaces: {e}")))?;
+        }
         let defaults: Vec<f64> = self.parameters.iter().map(|p| p.default).collect();
         self.spec(&probe, &defaults)
             .map_err(|e| bad(format!("does not build a simulator effect: {e}")))?;

@@ -1,22 +1,40 @@
-//! Sim-to-real gap diagnosis: where the simulator and measurements disagree, which
-//! unmodelled effect explains it, and how far the gap shrinks once that effect is added.
+//! Sim-to-real gap diagnosis: where the simulator and measurements disagree, and whether
+//! the design's uncertain parameters are off, an unmodelled effect is missing, both, or
+//! neither explains it — with how far the gap shrinks on held-out conditions.
 //!
 //! * [`trials`]: the measurement format (`dataset/trials/`), validated with file:line:column.
 //! * [`library`]: the candidate effects, as data (`dataset/effects/`): parameters, units,
 //!   plausible ranges, and how each becomes a term of the simulator ([`crate::sim::EffectSpec`]).
-//! * [`simulate`]: a trial condition run through the simulator, with or without an effect.
-//! * [`diagnose`]: standardised residuals ("where"), effect fitting over cached simulation
-//!   grids, leave-one-condition-out ranking, significance and intervals ("which", "how far").
-//! * [`synth`]: "real" trials simulated with a withheld effect plus measurement noise.
-//! * [`benchmark`]: identification, false alarms, parameter recovery over many synth cases.
+//! * [`knob`]: what a diagnosis can turn: the designs' `[[uncertain]]` parameters and the
+//!   effects' magnitudes; a model is a set of free knobs.
+//! * [`simulate`], [`cache`]: a trial condition through the simulator under a setting, and
+//!   the walks shared between fits.
+//! * [`curve`], [`surrogate`]: every knob walked over its range; the additive surrogate
+//!   with a per-model correction from real walks.
+//! * [`problem`] (the χ² cost), [`solver`] (Nelder–Mead, scans), [`fit`] (surrogate fit,
+//!   refinement with walks, held-out χ², profiles, consistency across groups).
+//! * [`select`]: forward selection with the call rules; [`diagnose`]: the answer;
+//!   [`locate`]: where the gap lies; [`identify`]: detection and identification thresholds.
+//! * [`synth`]: "real" trials simulated with withheld effects or wrong parameters plus noise.
+//! * [`benchmark`]: the diagnosis on cases of known cause, inside and outside its library.
 //!
 //! Depends on [`crate::sim`] (the simulator) and [`crate::regression`] (distributions) only.
 
 pub mod benchmark;
+pub mod cache;
+pub mod curve;
 pub mod diagnose;
 pub mod error;
+pub mod fit;
+pub mod identify;
+pub mod knob;
 pub mod library;
+pub mod locate;
+pub mod problem;
+pub mod select;
 pub mod simulate;
+pub mod solver;
+pub mod surrogate;
 pub mod synth;
 pub mod trials;
 

@@ -6,7 +6,8 @@ use std::path::Path;
 use rayon::prelude::*;
 
 use super::error::GapError;
-use super::library::{EffectLibrary, EffectSetting};
+use super::knob::ModelSetting;
+use super::library::EffectLibrary;
 use super::trials::{Metric, Trial, TrialSet};
 use crate::sim::design::ControlSpec;
 use crate::sim::{ContactScaling, Design, MassLaw, WalkOptions, simulate_walk};
@@ -109,15 +110,24 @@ fn resolve_trial(t: &Trial, origin: &str, base: &Path) -> Result<Condition, GapE
 }
 
 impl Condition {
-    /// The design scaled to the condition, with `effect` added (at the design's 1×, scaled
-    /// with it by the effect's rule).
+    /// The design scaled to the condition, with the setting's parameter values (on the 1×
+    /// design) and effects added (at the design's 1×, scaled with it by each effect's rule).
     pub fn design_with(
         &self,
         lib: &EffectLibrary,
-        effect: Option<&EffectSetting>,
+        setting: &ModelSetting,
     ) -> Result<Design, GapError> {
-        let mut d = self.design.clone();
-        if let Some(e) = effect {
+        let values: Vec<(&str, f64)> = setting.params_of(&self.design.name).collect();
+        let mut d = self
+            .design
+            .with_values(&values)
+            .map_err(|e| GapError::Sim {
+                origin: self.design.name.clone(),
+                source: e,
+            })?;
+        // Effect magnitudes are in the nominal design's units (its m·g·L, foot modulus, …):
+        // the SI value of an effect does not move when a parameter is recalibrated.
+        for e in &setting.effects {
             let def = lib.get(&e.effect)?;
             d.effects.push(def.spec(&self.design, &e.nondimensional)?);
         }
@@ -181,13 +191,13 @@ impl Condition {
         Ok(d.controller().frequency_hz().unwrap_or(f64::NAN))
     }
 
-    /// Simulates the condition with `effect` and measures the metrics.
+    /// Simulates the condition under `setting` and measures the metrics.
     pub fn simulate(
         &self,
         lib: &EffectLibrary,
-        effect: Option<&EffectSetting>,
+        setting: &ModelSetting,
     ) -> Result<SimMetrics, GapError> {
-        let d = self.design_with(lib, effect)?;
+        let d = self.design_with(lib, setting)?;
         let f = d.controller().frequency_hz().unwrap_or(1.0);
         let opts = WalkOptions {
             duration_s: CYCLES_PER_TRIAL / f,
@@ -209,16 +219,16 @@ impl Condition {
     }
 }
 
-/// Simulates many (condition, effect) jobs in parallel, in order.
+/// Simulates many (condition, setting) jobs in parallel, in order.
 pub fn simulate_jobs(
-    jobs: &[(usize, Option<EffectSetting>)],
+    jobs: &[(usize, ModelSetting)],
     conditions: &[Condition],
     lib: &EffectLibrary,
     progress: &(dyn Fn() + Sync),
 ) -> Result<Vec<SimMetrics>, GapError> {
     jobs.par_iter()
-        .map(|(i, e)| {
-            let r = conditions[*i].simulate(lib, e.as_ref());
+        .map(|(i, s)| {
+            let r = conditions[*i].simulate(lib, s);
             progress();
             r
         })

@@ -5,6 +5,7 @@ use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
 use super::error::GapError;
+use super::knob::ModelSetting;
 use super::library::{EffectLibrary, EffectSetting};
 use super::simulate::{Condition, SimMetrics, resolve};
 use super::trials::{Measurement, Metric, Trial, TrialSet};
@@ -134,6 +135,9 @@ pub fn add_noise(
 pub struct SynthOptions {
     pub design: String,
     pub effects: Vec<EffectSetting>,
+    /// Values of the design that differ from its file (path, value at 1×): "real" trials of
+    /// a robot whose nominal parameters are wrong.
+    pub params: Vec<(String, f64)>,
     pub noise: f64,
     pub seed: u64,
 }
@@ -162,7 +166,21 @@ pub fn synthesize(
         },
     };
     let resolved = resolve(&set)?;
-    let truth = truth_metrics(&resolved, lib, &opts.effects, progress)?;
+    let setting = ModelSetting {
+        params: resolved
+            .iter()
+            .map(|c| c.design.name.clone())
+            .collect::<std::collections::BTreeSet<_>>()
+            .into_iter()
+            .flat_map(|d| {
+                opts.params
+                    .iter()
+                    .map(move |(p, v)| (d.clone(), p.clone(), *v))
+            })
+            .collect(),
+        effects: opts.effects.clone(),
+    };
+    let truth = truth_metrics(&resolved, lib, &setting, progress)?;
     let trials = add_noise(&set.trials, &truth, opts.noise, opts.seed, command);
     Ok(TrialSet {
         origin: set.origin,
@@ -171,29 +189,18 @@ pub fn synthesize(
     })
 }
 
-/// The true metrics of the conditions with all `effects` added.
+/// The true metrics of the conditions under `setting` (parameter values and effects).
 pub fn truth_metrics(
     conditions: &[Condition],
     lib: &EffectLibrary,
-    effects: &[EffectSetting],
+    setting: &ModelSetting,
     progress: &(dyn Fn() + Sync),
 ) -> Result<Vec<SimMetrics>, GapError> {
     use rayon::prelude::*;
     conditions
         .par_iter()
         .map(|c| {
-            let mut c = c.clone();
-            // All but the last effect go into the design; the last through simulate().
-            let (last, rest) = match effects.split_last() {
-                Some((l, r)) => (Some(l), r),
-                None => (None, &[][..]),
-            };
-            for e in rest {
-                let def = lib.get(&e.effect)?;
-                let spec = def.spec(&c.design, &e.nondimensional)?;
-                c.design.effects.push(spec);
-            }
-            let r = c.simulate(lib, last);
+            let r = c.simulate(lib, setting);
             progress();
             r
         })

@@ -17,7 +17,7 @@
 
 mod bootstrap;
 mod diagnostics;
-mod dist;
+pub mod dist;
 mod error;
 mod hypothesis;
 mod line;

@@ -7,8 +7,9 @@ use plotters::prelude::*;
 
 use super::plot::{PlotError, register_font};
 use super::sig;
-use crate::gap::benchmark::BenchmarkResult;
-use crate::gap::diagnose::Diagnosis;
+use crate::gap::benchmark::{BenchmarkSummary, CaseRow};
+use crate::gap::diagnose::{AnswerKind, Diagnosis};
+use crate::gap::knob::KnobKind;
 use crate::gap::library::EffectSummary;
 use crate::gap::trials::Metric;
 
@@ -64,14 +65,49 @@ pub fn diagnosis_md(d: &Diagnosis) -> String {
         }
     );
     let _ = writeln!(o, "**Where:** {}.\n", d.summary);
-    let _ = writeln!(o, "**Verdict:** {}.\n", d.verdict);
+    let _ = writeln!(
+        o,
+        "**Answer ({}):** {}.\n",
+        answer_kind(d.answer.kind),
+        d.answer.statement
+    );
+    where_md(&mut o, d);
+    explanations_md(&mut o, d);
+    chain_md(&mut o, d);
+    calibration_md(&mut o, d);
+    single_md(&mut o, d);
+    identifiability_md(&mut o, d);
+    if !d.notes.is_empty() {
+        let _ = writeln!(o, "\nNotes:");
+        for n in &d.notes {
+            let _ = writeln!(o, "- {n}");
+        }
+    }
+    residuals_md(&mut o, d);
+    o
+}
+
+/// The answer kinds in words.
+pub fn answer_kind(k: AnswerKind) -> &'static str {
+    match k {
+        AnswerKind::WithinNoise => "no gap",
+        AnswerKind::ParametersOff => "parameters off",
+        AnswerKind::EffectMissing => "effect missing",
+        AnswerKind::Both => "parameters off and effect missing",
+        AnswerKind::PartlyExplained => "partly explained",
+        AnswerKind::Unexplained => "unexplained",
+        AnswerKind::Ambiguous => "ambiguous",
+    }
+}
+
+fn where_md(o: &mut String, d: &Diagnosis) {
     let _ = writeln!(o, "## Where the gap lies\n");
     let _ = writeln!(
         o,
         "| metric | n | RMS z | mean miss | p | trend per doubling of L | per doubling of f | RMS z after |"
     );
     let _ = writeln!(o, "|---|---:|---:|---:|---:|---:|---:|---:|");
-    let tr = |t: &Option<crate::gap::diagnose::Trend>| match t {
+    let tr = |t: &Option<crate::gap::locate::Trend>| match t {
         Some(t) => format!(
             "{:+.0} ± {:.0} pts",
             t.slope * std::f64::consts::LN_2 * 100.0,
@@ -92,66 +128,172 @@ pub fn diagnosis_md(d: &Diagnosis) -> String {
             tr(&g.trend_with_frequency),
             g.rms_z_after
                 .map(|v| format!("{v:.2}"))
-                .unwrap_or("–".into())
+                .unwrap_or_else(|| "–".into())
         );
     }
-    let _ = writeln!(o, "\n## Which effect\n");
+}
+
+fn explanations_md(o: &mut String, d: &Diagnosis) {
     let _ = writeln!(
         o,
-        "Ranked by held-out χ²/n (leave one condition out) plus a BIC penalty; significant = \
-         likelihood-ratio p below α/K and a held-out gap below the nominal's.\n"
+        "\n## Competing explanations (each confirmed with walks)\n"
     );
     let _ = writeln!(
         o,
-        "| effect | fitted | held-out gap | shrink | score | LR | p | significant |"
+        "Held-out gap: RMS z with every condition predicted by the model fitted to the others. \
+         p: likelihood-ratio test against the nominal, scaled by the over-dispersion left after \
+         the fit.\n"
     );
-    let _ = writeln!(o, "|---|---|---:|---:|---:|---:|---:|---|");
-    for r in &d.ranking {
-        let params = match r.magnitude_nondimensional {
-            Some(_) => r
-                .params
+    let _ = writeln!(
+        o,
+        "| model | free | fitted | χ² | held-out gap | shrink | p vs nominal | within noise |"
+    );
+    let _ = writeln!(o, "|---|---:|---|---:|---:|---:|---:|---|");
+    for e in &d.explanations {
+        let fitted = if e.knobs.is_empty() {
+            "–".to_string()
+        } else {
+            e.knobs
                 .iter()
                 .map(|(k, v)| format!("{k} = {}", sig(*v)))
                 .collect::<Vec<_>>()
-                .join(", "),
-            None => "off (nominal fits best)".into(),
+                .join(", ")
         };
         let _ = writeln!(
             o,
-            "| {} | {} | {:.2} | {:.0} % | {:.3} | {:.1} | {:.1e} | {} |",
-            r.effect,
-            params,
-            r.gap_after,
-            r.shrink_pct,
-            r.score,
-            r.lr,
-            r.p_value,
-            if r.significant { "yes" } else { "no" }
+            "| {} | {} | {} | {:.1} | {:.2} | {:.0} % | {} | {} |",
+            e.model,
+            e.free,
+            fitted,
+            e.chi2,
+            e.gap_held_out,
+            e.shrink_pct,
+            e.p_vs_nominal
+                .map(|p| format!("{p:.1e}"))
+                .unwrap_or_else(|| "–".into()),
+            if e.within_noise { "yes" } else { "no" }
         );
     }
-    if let Some(b) = &d.best {
-        let _ = writeln!(o, "\n**Best: {}**", b.effect);
-        for (k, v) in &b.params {
-            let ci = b
-                .params_ci
-                .get(k)
-                .map(|[lo, hi]| format!(" (95 % interval {} – {})", sig(*lo), sig(*hi)))
-                .unwrap_or_default();
-            let _ = writeln!(o, "- {k} = {}{ci}", sig(*v));
-        }
+}
+
+fn chain_md(o: &mut String, d: &Diagnosis) {
+    let _ = writeln!(o, "\n## The chain (forward selection)\n");
+    if d.chain.is_empty() {
+        let _ = writeln!(o, "No knob passed the call rules at the first step.");
+        return;
+    }
+    for (i, s) in d.chain.iter().enumerate() {
         let _ = writeln!(
             o,
-            "- held-out gap {:.2} → {:.2}, {:.0} % smaller (in-sample {:.2}){}",
-            d.gap_before,
-            b.gap_after,
-            b.shrink_pct,
-            b.gap_after_in_sample,
-            if b.ci_at_range_edge {
-                "; the interval reaches the end of the plausible range"
+            "{}. **{}** = {} → held-out gap {:.2} (−{:.0} % at this step, −{:.0} % in all); LR {:.1}, over-dispersion {:.2}, p = {:.1e}{}{}; {}",
+            i + 1,
+            s.knob,
+            sig(s.value_si),
+            s.gap_after,
+            s.shrink_pct,
+            s.shrink_total_pct,
+            s.lr,
+            s.dispersion,
+            s.p_value,
+            s.p_value_vs_recalibration
+                .map(|p| format!(", against the recalibration p = {p:.1e}"))
+                .unwrap_or_default(),
+            if s.not_separable_from.is_empty() {
+                String::new()
             } else {
-                ""
+                format!("; not separable from {}", s.not_separable_from.join(", "))
+            },
+            if s.within_noise_after {
+                "within noise after"
+            } else {
+                "still beyond noise after"
             }
         );
+    }
+    if let Some(last) = d.chain.last() {
+        let _ = writeln!(o, "\nCandidates at the last step:\n");
+        let _ = writeln!(o, "| knob | value | held-out gap | LR | p | verdict |");
+        let _ = writeln!(o, "|---|---:|---:|---:|---:|---|");
+        for c in &last.candidates {
+            let _ = writeln!(
+                o,
+                "| {} | {} | {:.2} | {:.1} | {:.1e} | {} |",
+                c.knob,
+                sig(c.value_si),
+                c.gap_after,
+                c.lr,
+                c.p_value,
+                c.verdict
+            );
+        }
+    }
+}
+
+fn calibration_md(o: &mut String, d: &Diagnosis) {
+    if d.calibration.is_empty() {
+        return;
+    }
+    let _ = writeln!(
+        o,
+        "\n## The best recalibration of the uncertain parameters\n\nWidth: the 95 % interval's share of the plausible range (near 1: these trials do not pin the parameter down).\n"
+    );
+    let _ = writeln!(
+        o,
+        "| parameter | file | recalibrated | 95 % interval | range | move (prior sd) | width | why uncertain |"
+    );
+    let _ = writeln!(o, "|---|---:|---:|---|---|---:|---:|---|");
+    for c in &d.calibration {
+        let _ = writeln!(
+            o,
+            "| {} | {} | {} | {} – {} | {} – {} | {} | {:.2} | {} |",
+            c.parameter,
+            sig(c.nominal),
+            sig(c.value),
+            sig(c.interval[0]),
+            sig(c.interval[1]),
+            sig(c.range[0]),
+            sig(c.range[1]),
+            c.move_in_sd
+                .map(|m| format!("{m:+.1}"))
+                .unwrap_or_else(|| "–".into()),
+            c.width_of_range,
+            c.why.replace('|', "/")
+        );
+    }
+}
+
+fn single_md(o: &mut String, d: &Diagnosis) {
+    let _ = writeln!(
+        o,
+        "\n## Every knob alone (from the nominal, surrogate fit)\n"
+    );
+    let _ = writeln!(
+        o,
+        "| knob | kind | fitted | held-out gap | shrink | LR | p |"
+    );
+    let _ = writeln!(o, "|---|---|---:|---:|---:|---:|---:|");
+    for s in &d.single {
+        let _ = writeln!(
+            o,
+            "| {} | {} | {} {} | {:.2} | {:.0} % | {:.1} | {:.1e} |",
+            s.knob,
+            match s.kind {
+                KnobKind::Parameter => "parameter",
+                KnobKind::Effect => "effect",
+            },
+            sig(s.value),
+            s.unit,
+            s.gap_held_out,
+            s.shrink_pct,
+            s.lr,
+            s.p_value
+        );
+    }
+}
+
+fn identifiability_md(o: &mut String, d: &Diagnosis) {
+    if d.identifiability.is_empty() {
+        return;
     }
     let _ = writeln!(o, "\n## Identifiability with these trials\n");
     let _ = writeln!(
@@ -176,12 +318,9 @@ pub fn diagnosis_md(d: &Diagnosis) -> String {
                 .join(", ")
         );
     }
-    if !d.notes.is_empty() {
-        let _ = writeln!(o, "\nNotes:");
-        for n in &d.notes {
-            let _ = writeln!(o, "- {n}");
-        }
-    }
+}
+
+fn residuals_md(o: &mut String, d: &Diagnosis) {
     let _ = writeln!(o, "\n## Residuals\n");
     let _ = writeln!(
         o,
@@ -206,7 +345,6 @@ pub fn diagnosis_md(d: &Diagnosis) -> String {
             r.z_after.map(|z| format!("{z:+.1}")).unwrap_or("–".into()),
         );
     }
-    o
 }
 
 fn metric_color(m: Metric) -> RGBColor {
@@ -222,8 +360,8 @@ fn metric_color(m: Metric) -> RGBColor {
     }
 }
 
-/// Standardised residuals per condition and metric, before (left) and after the best
-/// effect (right); ±2 marked. SVG or PNG by extension.
+/// Standardised residuals per condition and metric, before (left) and after the chain's
+/// model (right); ±2 marked. SVG or PNG by extension.
 pub fn residual_plot(d: &Diagnosis, path: &Path) -> Result<(), PlotError> {
     register_font();
     let err = |m: String| PlotError {
@@ -268,9 +406,17 @@ fn draw_residuals<DB: DrawingBackend>(
                 .min(60.0)
                 * 1.1;
             let title = if after {
-                match &d.best {
-                    Some(b) => format!("after: + {} (held-out RMS z {:.2})", b.effect, b.gap_after),
-                    None => "after: no effect called".to_string(),
+                match d.chain.last() {
+                    Some(s) => format!(
+                        "after: {} (held-out RMS z {:.2})",
+                        d.chain
+                            .iter()
+                            .map(|s| s.knob.as_str())
+                            .collect::<Vec<_>>()
+                            .join(" + "),
+                        s.gap_after
+                    ),
+                    None => "after: nothing called".to_string(),
                 }
             } else {
                 format!("nominal model (RMS z {:.2})", d.gap_before)
@@ -332,175 +478,209 @@ fn draw_residuals<DB: DrawingBackend>(
     }
 }
 
-/// The benchmark as Markdown.
-pub fn benchmark_md(b: &BenchmarkResult) -> String {
+/// The benchmark as Markdown: scores against targets, thresholds, confusion matrices, and
+/// the cases outside the library one by one.
+pub fn benchmark_md(b: &BenchmarkSummary, rows: &[CaseRow], command: &str) -> String {
     let mut o = String::new();
     let _ = writeln!(
         o,
-        "# Gap-diagnosis benchmark ({}, {} conditions, {} seeds per case, {} null cases per noise level)\n",
-        b.design, b.conditions, b.seeds, b.null_seeds
+        "# Gap-diagnosis benchmark ({}, {} cases)\n",
+        b.design, b.cases
     );
     let _ = writeln!(
         o,
-        "Generated by `survey gap benchmark` ({} walks, {:.0} s, {:.1} s per diagnosis).\n",
-        b.walks, b.seconds, b.seconds_per_diagnosis
+        "Generated by `{command}` (resumable and shardable: `--points FILE`, `--shard i/n`, \
+         `--merge`). Rates with their 95 % Clopper–Pearson interval and one-sided 95 % upper \
+         bound. A case *names* a knob when the diagnosis' answer lists it (parameters off, \
+         effect missing, both, or partly explained); an effect whose quantity the design \
+         declares uncertain (friction_coefficient ↔ contact.friction_mu) counts as named when \
+         that parameter is.\n"
     );
-    let _ = writeln!(o, "## Summary per noise level\n");
+    let _ = writeln!(o, "## Scores\n");
     let _ = writeln!(
         o,
-        "| noise | correct above threshold | false alarms | interval coverage | median \\|ln(fit/true)\\| | median shrink |"
+        "| what | k / n | rate | 95 % interval | upper 95 % | target |"
     );
-    let _ = writeln!(o, "|---:|---:|---:|---:|---:|---:|");
-    for c in &b.confusion {
+    let _ = writeln!(o, "|---|---:|---:|---|---:|---|");
+    for sc in &b.scores {
         let _ = writeln!(
             o,
-            "| {:.0} % | {:.0} % ({} cases) | {} / {} | {:.0} % | {:.3} | {:.0} % |",
-            c.noise * 100.0,
-            c.identification_rate_above_threshold * 100.0,
-            c.cases_above_threshold,
-            c.false_alarms,
-            c.null_cases,
-            c.coverage * 100.0,
-            c.median_log_error,
-            c.median_shrink_pct
+            "| {} | {} / {} | {:.1} % | {:.1}–{:.1} % | {:.1} % | {} |",
+            sc.what,
+            sc.k,
+            sc.n,
+            sc.rate * 100.0,
+            sc.interval[0] * 100.0,
+            sc.interval[1] * 100.0,
+            sc.upper_95 * 100.0,
+            sc.target
         );
     }
-    let _ = writeln!(o, "\n## Thresholds (SI, {} at 1×)\n", b.design);
     let _ = writeln!(
         o,
-        "Detection: the likelihood-ratio test finds the effect with 90 % power at the noise level. \
-         Identification: the effect is also told from its closest mimic with 90 % probability.\n"
+        "\n## Identification thresholds (SI, {} at 1×: against the other effects, each uncertain parameter, and the recalibration of all of them, confirmed with walks; an effect the design calibrates as a parameter: against the other effects)\n",
+        b.design
     );
-    let _ = writeln!(
-        o,
-        "| effect | noise | parameter | detected from | identified from | closest mimic | shows in |"
-    );
-    let _ = writeln!(o, "|---|---:|---|---:|---:|---|---|");
-    for t in &b.thresholds {
-        let i = &t.identifiability;
-        let _ = writeln!(
-            o,
-            "| {} | {:.0} % | {} [{}] | {} | {} | {} | {} |",
-            i.effect,
-            t.noise * 100.0,
-            i.parameter,
-            i.unit,
-            opt(i.detection_threshold),
-            opt(i.identification_threshold),
-            i.closest_mimic.clone().unwrap_or("–".into()),
-            i.identifiable_from
-                .iter()
-                .map(|m| m.column())
-                .collect::<Vec<_>>()
-                .join(", ")
-        );
+    let names: Vec<String> = b
+        .thresholds
+        .values()
+        .next()
+        .map(|v| v.iter().map(|(e, _)| e.clone()).collect())
+        .unwrap_or_default();
+    let _ = write!(o, "| effect |");
+    for n in b.thresholds.keys() {
+        let noise: f64 = n.parse().unwrap_or(f64::NAN);
+        let _ = write!(o, " {:.0} % noise |", noise * 100.0);
     }
-    for c in &b.confusion {
+    let _ = writeln!(o);
+    let _ = write!(o, "|---|");
+    for _ in b.thresholds.keys() {
+        let _ = write!(o, "---:|");
+    }
+    let _ = writeln!(o);
+    for e in &names {
+        let _ = write!(o, "| {e} |");
+        for v in b.thresholds.values() {
+            let t = v.iter().find(|(n, _)| n == e).and_then(|(_, t)| *t);
+            let _ = write!(o, " {} |", opt(t));
+        }
+        let _ = writeln!(o);
+    }
+    for c in &b.confusions {
         let _ = writeln!(
             o,
-            "\n## Confusion at {:.0} % noise (rows: true effect, above threshold, and null; columns: called)\n",
-            c.noise * 100.0
+            "\n## Confusion: {} (rows: truth; columns: named first)\n",
+            c.title
         );
-        let _ = write!(o, "| true \\ called |");
-        for l in &c.labels {
+        let _ = write!(o, "| truth \\ named |");
+        for l in &c.columns {
             let _ = write!(o, " {l} |");
         }
         let _ = writeln!(o);
         let _ = write!(o, "|---|");
-        for _ in &c.labels {
+        for _ in &c.columns {
             let _ = write!(o, "---:|");
         }
         let _ = writeln!(o);
-        for (l, row) in c.labels.iter().zip(&c.counts) {
-            let name = if l == "none" { "null (no effect)" } else { l };
-            let _ = write!(o, "| {name} |");
+        for (l, row) in c.rows.iter().zip(&c.counts) {
+            let _ = write!(o, "| {l} |");
             for v in row {
                 let _ = write!(o, " {v} |");
             }
             let _ = writeln!(o);
         }
     }
-    let _ = writeln!(o, "\n## Cases\n");
-    let _ = writeln!(
-        o,
-        "| noise | true | ×thr | magnitude | above | called | fitted | interval | covered | shrink |"
-    );
-    let _ = writeln!(o, "|---:|---|---:|---:|---|---|---:|---|---|---:|");
-    for c in &b.cases {
+    let listed: Vec<&CaseRow> = rows
+        .iter()
+        .filter(|r| r.kind == "parameter" || r.kind == "drake" || r.kind == "pair")
+        .collect();
+    if !listed.is_empty() {
         let _ = writeln!(
             o,
-            "| {:.0} % | {} | {} | {} | {} | {} | {} | {} | {} | {} |",
-            c.noise * 100.0,
-            c.true_effect.clone().unwrap_or("null".into()),
-            c.multiple.map(|m| format!("{m}")).unwrap_or("–".into()),
-            opt(c.magnitude),
-            if c.above_threshold { "yes" } else { "no" },
-            c.called.clone().unwrap_or("none".into()),
-            opt(c.fitted),
-            c.ci.map(|[a, b]| format!("{} – {}", sig(a), sig(b)))
-                .unwrap_or("–".into()),
-            c.covered
-                .map(|v| if v { "yes" } else { "no" })
-                .unwrap_or("–"),
-            c.shrink_pct
-                .map(|s| format!("{s:.0} %"))
-                .unwrap_or("–".into())
+            "\n## Cases outside the single-effect world, one by one\n"
         );
+        let _ = writeln!(
+            o,
+            "| case | truth | answer | named | intervals | gap before → after |"
+        );
+        let _ = writeln!(o, "|---|---|---|---|---|---|");
+        for r in listed {
+            let truth = [r.truth_params.as_str(), r.truth_effects.as_str()]
+                .iter()
+                .filter(|s| !s.is_empty())
+                .copied()
+                .collect::<Vec<_>>()
+                .join("; ");
+            let named = [r.named_params.as_str(), r.named_effects.as_str()]
+                .iter()
+                .filter(|s| !s.is_empty())
+                .copied()
+                .collect::<Vec<_>>()
+                .join("; ");
+            let _ = writeln!(
+                o,
+                "| {} | {} | {} | {} | {} | {:.2} → {} |",
+                r.key,
+                if truth.is_empty() { "none" } else { &truth },
+                r.answer,
+                if named.is_empty() { "–" } else { &named },
+                if r.intervals.is_empty() {
+                    "–".to_string()
+                } else {
+                    r.intervals
+                        .split(';')
+                        .map(|iv| match iv.split_once('=') {
+                            Some((k, v)) => {
+                                let (lo, hi) = v.split_once("..").unwrap_or((v, v));
+                                let f = |x: &str| {
+                                    x.parse::<f64>().map(sig).unwrap_or_else(|_| x.into())
+                                };
+                                format!(
+                                    "{} [{}, {}]",
+                                    k.rsplit(':').next().unwrap_or(k),
+                                    f(lo),
+                                    f(hi)
+                                )
+                            }
+                            None => iv.to_string(),
+                        })
+                        .collect::<Vec<_>>()
+                        .join("; ")
+                },
+                r.gap_before,
+                r.gap_after
+                    .map(|g| format!("{g:.2}"))
+                    .unwrap_or_else(|| "–".into())
+            );
+        }
     }
     o
 }
 
-/// Confusion matrices as heat maps, one panel per noise level.
-pub fn confusion_plot(b: &BenchmarkResult, path: &Path) -> Result<(), PlotError> {
+/// The benchmark's confusion matrices as heat maps, one panel each (SVG).
+pub fn confusion_plot(b: &BenchmarkSummary, path: &Path) -> Result<(), PlotError> {
     register_font();
     let err = |m: String| PlotError {
         path: path.display().to_string(),
         message: m,
     };
-    let n = b.confusion.len().max(1) as u32;
-    let root = SVGBackend::new(path, (520 * n, 560)).into_drawing_area();
+    let n = b.confusions.len().max(1) as u32;
+    let cols = n.min(3);
+    let rows_n = n.div_ceil(cols);
+    let root = SVGBackend::new(path, (620 * cols, 600 * rows_n)).into_drawing_area();
     let draw = || -> Result<(), String> {
         root.fill(&WHITE).map_err(|e| e.to_string())?;
-        let panels = root.split_evenly((1, n as usize));
-        for (c, area) in b.confusion.iter().zip(panels.iter()) {
-            let k = c.labels.len();
+        let panels = root.split_evenly((rows_n as usize, cols as usize));
+        for (c, area) in b.confusions.iter().zip(panels.iter()) {
+            let (nr, nc) = (c.rows.len().max(1), c.columns.len().max(1));
             let mut chart = ChartBuilder::on(area)
-                .caption(
-                    format!(
-                        "{:.0} % noise: {:.0} % correct, {} false alarms",
-                        c.noise * 100.0,
-                        c.identification_rate_above_threshold * 100.0,
-                        c.false_alarms
-                    ),
-                    ("sans-serif", 16),
-                )
+                .caption(&c.title, ("sans-serif", 15))
                 .margin(10)
-                .x_label_area_size(150)
-                .y_label_area_size(150)
-                .build_cartesian_2d(0..k, 0..k)
+                .x_label_area_size(170)
+                .y_label_area_size(190)
+                .build_cartesian_2d(0..nc, 0..nr)
                 .map_err(|e| e.to_string())?;
-            let labels = c.labels.clone();
-            let labels2 = c.labels.clone();
+            let xl = c.columns.clone();
+            let yl = c.rows.clone();
             chart
                 .configure_mesh()
                 .disable_mesh()
-                .x_labels(k)
-                .y_labels(k)
-                .x_label_formatter(&|i| labels.get(*i).cloned().unwrap_or_default())
+                .x_labels(nc)
+                .y_labels(nr)
+                .x_label_formatter(&|i| xl.get(*i).cloned().unwrap_or_default())
                 .y_label_formatter(&|i| {
-                    labels2
-                        .get(k - 1 - (*i).min(k - 1))
+                    yl.get(nr - 1 - (*i).min(nr - 1))
                         .cloned()
                         .unwrap_or_default()
                 })
                 .x_label_style(
-                    ("sans-serif", 11)
+                    ("sans-serif", 10)
                         .into_font()
                         .transform(FontTransform::Rotate90),
                 )
-                .y_label_style(("sans-serif", 11))
-                .x_desc("called")
-                .y_desc("true")
+                .y_label_style(("sans-serif", 10))
+                .x_desc("named first")
+                .y_desc("truth")
                 .draw()
                 .map_err(|e| e.to_string())?;
             for (i, row) in c.counts.iter().enumerate() {
@@ -511,8 +691,11 @@ pub fn confusion_plot(b: &BenchmarkResult, path: &Path) -> Result<(), PlotError>
                     } else {
                         0.0
                     };
-                    let y = k - 1 - i;
-                    let color = if i == j {
+                    let y = nr - 1 - i;
+                    let right = c.columns[j] == c.rows[i]
+                        || (c.rows[i] == "null" && c.columns[j] == "none")
+                        || c.columns[j].ends_with(c.rows[i].split('=').next().unwrap_or("#"));
+                    let color = if right {
                         RGBColor(44, 160, 44)
                     } else {
                         RGBColor(214, 39, 40)
@@ -528,7 +711,7 @@ pub fn confusion_plot(b: &BenchmarkResult, path: &Path) -> Result<(), PlotError>
                             .draw_series(std::iter::once(Text::new(
                                 format!("{v}"),
                                 (j, y + 1),
-                                ("sans-serif", 12),
+                                ("sans-serif", 11),
                             )))
                             .map_err(|e| e.to_string())?;
                     }

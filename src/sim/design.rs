@@ -228,6 +228,87 @@ pub struct Design {
     pub ground: GroundSpec,
     #[serde(default)]
     pub effects: Vec<EffectSpec>,
+    /// Values of this file that are guesses ([CHOSEN], [REF], unpublished): what the gap
+    /// diagnosis may calibrate, with their plausible ranges. Not physics: scaling, walks and
+    /// the design hash of a study ignore them.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub uncertain: Vec<UncertainSpec>,
+}
+
+/// A number of a design file that is not known: where it is, how far it may be off, and why.
+/// Give a `range` (plausible values, a uniform prior), an `sd` or `relative_sd` (a Gaussian
+/// prior around the file's value; the range then defaults to ±3 sd), or both.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct UncertainSpec {
+    /// Dotted path of a number in the design file: `mass.leg_com_height_over_l`,
+    /// `mass.leg_inertia_box_over_l[0]`, `effects[0].no_load_speed_rad_s`.
+    pub path: String,
+    /// Plausible values [min, max], in the field's unit.
+    #[serde(default)]
+    pub range: Option<[f64; 2]>,
+    /// Prior standard deviation, in the field's unit.
+    #[serde(default)]
+    pub sd: Option<f64>,
+    /// Prior standard deviation as a fraction of the file's value.
+    #[serde(default)]
+    pub relative_sd: Option<f64>,
+    /// Calibrate on a log scale (for positive quantities spanning a factor of several).
+    #[serde(default)]
+    pub log: bool,
+    /// Why the value is uncertain (its tag and the reasoning).
+    pub why: String,
+}
+
+/// An [`UncertainSpec`] resolved against its design: the file's value, bounds and prior.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct UncertainParam {
+    pub path: String,
+    pub nominal: f64,
+    pub lo: f64,
+    pub hi: f64,
+    /// Gaussian prior sd in the field's unit (None: uniform over [lo, hi]).
+    pub prior_sd: Option<f64>,
+    pub log: bool,
+    pub why: String,
+}
+
+/// One step of a dotted path: a key, optionally indexed.
+fn path_steps(path: &str) -> Option<Vec<(&str, Option<usize>)>> {
+    path.split('.')
+        .map(|seg| match seg.split_once('[') {
+            None if !seg.is_empty() => Some((seg, None)),
+            Some((k, rest)) if !k.is_empty() => {
+                let i = rest.strip_suffix(']')?.parse().ok()?;
+                Some((k, Some(i)))
+            }
+            _ => None,
+        })
+        .collect()
+}
+
+/// The number at `path` of a TOML tree, mutably.
+fn number_at<'a>(root: &'a mut toml::Value, path: &str) -> Result<&'a mut toml::Value, String> {
+    let steps = path_steps(path).ok_or_else(|| {
+        format!("`{path}` is not a dotted path such as mass.leg_com_height_over_l or mass.leg_inertia_box_over_l[0]")
+    })?;
+    let mut v = root;
+    for (key, index) in steps {
+        v = v
+            .as_table_mut()
+            .and_then(|t| t.get_mut(key))
+            .ok_or_else(|| format!("`{path}`: no field `{key}` in the design"))?;
+        if let Some(i) = index {
+            v = v
+                .as_array_mut()
+                .and_then(|a| a.get_mut(i))
+                .ok_or_else(|| format!("`{path}`: `{key}` has no element {i}"))?;
+        }
+    }
+    match v {
+        toml::Value::Float(_) | toml::Value::Integer(_) => Ok(v),
+        _ => Err(format!("`{path}` is not a number")),
+    }
 }
 
 impl Design {
@@ -238,6 +319,7 @@ impl Design {
             message: e.to_string(),
         })?;
         d.validate(origin)?;
+        d.check_uncertain(origin)?;
         Ok(d)
     }
 
@@ -535,6 +617,177 @@ impl Design {
         )?;
         for (n, e) in self.effects.iter().enumerate() {
             e.validate(origin, &format!("effects[{n}]"))?;
+        }
+        Ok(())
+    }
+
+    /// The number at a dotted `path` of this design (see [`UncertainSpec::path`]).
+    pub fn value_at(&self, path: &str) -> Result<f64, SimError> {
+        let mut tree = self.to_tree()?;
+        let v = number_at(&mut tree, path).map_err(|reason| self.bad_path(path, reason))?;
+        Ok(v.as_float()
+            .or_else(|| v.as_integer().map(|i| i as f64))
+            .unwrap_or(f64::NAN))
+    }
+
+    /// This design with the number at `path` set to `value`, validated (an out-of-range
+    /// value is an error naming the field, as in a file).
+    pub fn with_value(&self, path: &str, value: f64) -> Result<Design, SimError> {
+        self.with_values(&[(path, value)])
+    }
+
+    /// This design with several numbers set at once (one round trip through the TOML tree).
+    pub fn with_values(&self, values: &[(&str, f64)]) -> Result<Design, SimError> {
+        if values.is_empty() {
+            return Ok(self.clone());
+        }
+        let mut tree = self.to_tree()?;
+        for (path, value) in values {
+            *number_at(&mut tree, path).map_err(|reason| self.bad_path(path, reason))? =
+                toml::Value::Float(*value);
+        }
+        let d: Design = tree
+            .try_into()
+            .map_err(|e: toml::de::Error| SimError::Parse {
+                origin: self.name.clone(),
+                message: e.message().to_string(),
+            })?;
+        d.validate(&self.name)?;
+        Ok(d)
+    }
+
+    fn to_tree(&self) -> Result<toml::Value, SimError> {
+        toml::Value::try_from(self).map_err(|e| SimError::Parse {
+            origin: self.name.clone(),
+            message: e.to_string(),
+        })
+    }
+
+    fn bad_path(&self, path: &str, reason: String) -> SimError {
+        SimError::InvalidValue {
+            origin: self.name.clone(),
+            field: path.to_string(),
+            value: "—".into(),
+            reason,
+        }
+    }
+
+    /// The `[[uncertain]]` entries resolved: value, bounds and prior of each.
+    pub fn uncertain_params(&self) -> Result<Vec<UncertainParam>, SimError> {
+        self.uncertain
+            .iter()
+            .enumerate()
+            .map(|(i, u)| self.resolve_uncertain(i, u, &self.name))
+            .collect()
+    }
+
+    fn resolve_uncertain(
+        &self,
+        i: usize,
+        u: &UncertainSpec,
+        origin: &str,
+    ) -> Result<UncertainParam, SimError> {
+        let field = format!("uncertain[{i}] ({})", u.path);
+        let bad = |value: String, reason: &str| SimError::InvalidValue {
+            origin: origin.to_string(),
+            field: field.clone(),
+            value,
+            reason: reason.to_string(),
+        };
+        let nominal = self
+            .value_at(&u.path)
+            .map_err(|e| bad(u.path.clone(), &e.to_string()))?;
+        let prior_sd = match (u.sd, u.relative_sd) {
+            (Some(_), Some(_)) => {
+                return Err(bad(
+                    "sd and relative_sd".into(),
+                    "give one of them, not both",
+                ));
+            }
+            (Some(sd), None) => Some(sd),
+            (None, Some(r)) => {
+                if nominal == 0.0 {
+                    return Err(bad(
+                        format!("relative_sd = {r}"),
+                        "the file's value is 0: give an sd or a range instead",
+                    ));
+                }
+                Some(r * nominal.abs())
+            }
+            (None, None) => None,
+        };
+        if let Some(sd) = prior_sd
+            && !(sd > 0.0 && sd.is_finite())
+        {
+            return Err(bad(format!("sd = {sd}"), "must be finite and > 0"));
+        }
+        let [lo, hi] = match (u.range, prior_sd) {
+            (Some(r), _) => r,
+            (None, Some(sd)) => [nominal - 3.0 * sd, nominal + 3.0 * sd],
+            (None, None) => {
+                return Err(bad(
+                    "no range, sd or relative_sd".into(),
+                    "give a plausible range or a prior sd",
+                ));
+            }
+        };
+        if !(lo.is_finite() && hi.is_finite() && lo < hi) {
+            return Err(bad(
+                format!("[{lo}, {hi}]"),
+                "range must be finite with min < max",
+            ));
+        }
+        if !(lo <= nominal && nominal <= hi) {
+            return Err(bad(
+                format!("{nominal} outside [{lo}, {hi}]"),
+                "the file's value must lie in its plausible range",
+            ));
+        }
+        if u.log && lo <= 0.0 {
+            return Err(bad(
+                format!("[{lo}, {hi}]"),
+                "a log-scale range must be > 0",
+            ));
+        }
+        for end in [lo, hi] {
+            self.with_value(&u.path, end).map_err(|e| {
+                bad(
+                    format!("{end}"),
+                    &format!("the range's end is not a valid design: {e}"),
+                )
+            })?;
+        }
+        Ok(UncertainParam {
+            path: u.path.clone(),
+            nominal,
+            lo,
+            hi,
+            prior_sd,
+            log: u.log,
+            why: u.why.clone(),
+        })
+    }
+
+    fn check_uncertain(&self, origin: &str) -> Result<(), SimError> {
+        let mut seen = std::collections::HashSet::new();
+        for (i, u) in self.uncertain.iter().enumerate() {
+            if !seen.insert(u.path.as_str()) {
+                return Err(SimError::InvalidValue {
+                    origin: origin.to_string(),
+                    field: format!("uncertain[{i}]"),
+                    value: u.path.clone(),
+                    reason: "the same path is declared twice".into(),
+                });
+            }
+            if u.why.trim().is_empty() {
+                return Err(SimError::InvalidValue {
+                    origin: origin.to_string(),
+                    field: format!("uncertain[{i}].why"),
+                    value: "\"\"".into(),
+                    reason: "say why the value is uncertain (its tag and reasoning)".into(),
+                });
+            }
+            self.resolve_uncertain(i, u, origin)?;
         }
         Ok(())
     }

@@ -180,7 +180,12 @@ impl Table3Spec {
 /// The first 16 hex digits of the SHA-256 of a design's full parameter set (JSON): a
 /// points file names the exact designs it was made with.
 pub fn design_hash(d: &Design) -> String {
-    let json = serde_json::to_string(d).unwrap_or_default();
+    // The uncertain-parameter declarations are not physics: the same walks with or without.
+    let physics = Design {
+        uncertain: Vec::new(),
+        ..d.clone()
+    };
+    let json = serde_json::to_string(&physics).unwrap_or_default();
     let hash = Sha256::digest(json.as_bytes());
     hash.iter().take(8).map(|b| format!("{b:02x}")).collect()
 }

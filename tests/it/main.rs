@@ -6,6 +6,7 @@ mod common;
 mod diff;
 mod drake_crosscheck;
 mod gap;
+mod gap_open;
 mod live_dataset;
 mod load_fuzz;
 mod min_torque;

@@ -1,0 +1,135 @@
+//! Walks shared between fits, refits and diagnoses of trials over the same conditions (the
+//! benchmark runs thousands of diagnoses on one set): key = (condition, the setting's
+//! canonical key for that condition's design).
+
+use std::collections::HashMap;
+use std::sync::Mutex;
+use std::sync::atomic::{AtomicUsize, Ordering};
+
+use super::error::GapError;
+use super::knob::ModelSetting;
+use super::library::EffectLibrary;
+use super::simulate::{Condition, SimMetrics, simulate_jobs};
+
+#[derive(Default)]
+pub struct SimCache {
+    map: Mutex<HashMap<(usize, String), SimMetrics>>,
+    walks: AtomicUsize,
+}
+
+impl SimCache {
+    /// Walks simulated through this cache so far.
+    pub fn walks(&self) -> usize {
+        self.walks.load(Ordering::Relaxed)
+    }
+
+    /// Metrics of `setting` on every condition, walking only what the cache lacks.
+    pub fn get(
+        &self,
+        conditions: &[Condition],
+        lib: &EffectLibrary,
+        setting: &ModelSetting,
+        progress: &(dyn Fn() + Sync),
+    ) -> Result<Vec<SimMetrics>, GapError> {
+        self.get_many(conditions, lib, std::slice::from_ref(setting), progress)
+            .map(|mut v| v.remove(0))
+    }
+
+    /// Metrics of several settings on every condition ([setting][condition]), the missing
+    /// walks in one parallel batch.
+    pub fn get_many(
+        &self,
+        conditions: &[Condition],
+        lib: &EffectLibrary,
+        settings: &[ModelSetting],
+        progress: &(dyn Fn() + Sync),
+    ) -> Result<Vec<Vec<SimMetrics>>, GapError> {
+        let keys: Vec<Vec<(usize, String)>> = settings
+            .iter()
+            .map(|s| {
+                conditions
+                    .iter()
+                    .enumerate()
+                    .map(|(i, c)| (i, s.key_for(&c.design.name)))
+                    .collect()
+            })
+            .collect();
+        let mut jobs: Vec<(usize, ModelSetting)> = Vec::new();
+        let mut job_keys: Vec<(usize, String)> = Vec::new();
+        {
+            let map = self.lock()?;
+            let mut queued = std::collections::HashSet::new();
+            for (ks, s) in keys.iter().zip(settings) {
+                for k in ks {
+                    if !map.contains_key(k) && queued.insert(k.clone()) {
+                        jobs.push((k.0, s.clone()));
+                        job_keys.push(k.clone());
+                    }
+                }
+            }
+        }
+        let done = simulate_jobs(&jobs, conditions, lib, progress)?;
+        self.walks.fetch_add(jobs.len(), Ordering::Relaxed);
+        let mut map = self.lock()?;
+        for (k, m) in job_keys.into_iter().zip(done) {
+            map.insert(k, m);
+        }
+        keys.iter()
+            .map(|ks| {
+                ks.iter()
+                    .map(|k| {
+                        map.get(k)
+                            .copied()
+                            .ok_or_else(|| GapError::Invalid("cache miss after simulation".into()))
+                    })
+                    .collect()
+            })
+            .collect()
+    }
+
+    /// Metrics of `setting` on the conditions `which` (indices into `conditions`), in that
+    /// order, walking only what the cache lacks.
+    pub fn get_at(
+        &self,
+        conditions: &[Condition],
+        which: &[usize],
+        lib: &EffectLibrary,
+        setting: &ModelSetting,
+        progress: &(dyn Fn() + Sync),
+    ) -> Result<Vec<SimMetrics>, GapError> {
+        let keys: Vec<(usize, String)> = which
+            .iter()
+            .map(|i| (*i, setting.key_for(&conditions[*i].design.name)))
+            .collect();
+        let missing: Vec<(usize, String)> = {
+            let map = self.lock()?;
+            keys.iter()
+                .filter(|k| !map.contains_key(*k))
+                .cloned()
+                .collect()
+        };
+        let jobs: Vec<(usize, ModelSetting)> =
+            missing.iter().map(|(i, _)| (*i, setting.clone())).collect();
+        let done = simulate_jobs(&jobs, conditions, lib, progress)?;
+        self.walks.fetch_add(jobs.len(), Ordering::Relaxed);
+        let mut map = self.lock()?;
+        for (k, m) in missing.into_iter().zip(done) {
+            map.insert(k, m);
+        }
+        keys.iter()
+            .map(|k| {
+                map.get(k)
+                    .copied()
+                    .ok_or_else(|| GapError::Invalid("cache miss after simulation".into()))
+            })
+            .collect()
+    }
+
+    fn lock(
+        &self,
+    ) -> Result<std::sync::MutexGuard<'_, HashMap<(usize, String), SimMetrics>>, GapError> {
+        self.map
+            .lock()
+            .map_err(|_| GapError::Invalid("a worker panicked while holding the walk cache".into()))
+    }
+}

@@ -1,0 +1,365 @@
+//! The knobs a diagnosis can turn: the uncertain parameters a design declares
+//! (`[[uncertain]]`: model error) and the magnitudes of the library's effects (physics the
+//! nominal model lacks). A *model* is a set of knobs set free; the others stay at the
+//! nominal value (parameters) or off (effects). A *point* gives every free knob a value.
+//!
+//! Each knob has a coordinate: its value, or ln(value) for effect magnitudes and log-scale
+//! parameters, bounded by its plausible range. Parameters may carry a Gaussian prior
+//! (the design's `sd` or `relative_sd`), charged as ((value − nominal)/sd)² in the χ².
+
+use serde::Serialize;
+
+use super::library::{EffectDef, EffectLibrary, EffectSetting};
+use crate::sim::Design;
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum KnobKind {
+    /// An uncertain parameter of a design (model error).
+    Parameter,
+    /// An effect of the library (unmodelled physics).
+    Effect,
+}
+
+#[derive(Clone, Debug, Serialize)]
+pub struct Knob {
+    pub kind: KnobKind,
+    /// Parameter: the design it belongs to. Effect: empty (effects act on every design,
+    /// scaled by their rule).
+    pub design: String,
+    /// Parameter path (`mass.leg_com_height_over_l`) or effect name.
+    pub name: String,
+    /// The coordinate is ln(value).
+    pub log: bool,
+    /// Bounds of the coordinate.
+    pub lo: f64,
+    pub hi: f64,
+    /// The nominal model's coordinate; None for an effect whose off value lies outside its
+    /// range (off = absent).
+    pub nominal: Option<f64>,
+    /// Effects: the value at which the effect is absent (0, ∞, or inside the range such as
+    /// the design's own μ); parameters: None.
+    pub off_value: Option<f64>,
+    /// Gaussian prior (mean, sd) in value units.
+    pub prior: Option<(f64, f64)>,
+    /// Value → SI at the design's 1× size (effects: the scale unit; parameters: 1).
+    pub si_per_value: f64,
+    /// SI unit.
+    pub unit: String,
+    /// Why the knob is there (the design's reason, or the effect's description).
+    pub why: String,
+}
+
+impl Knob {
+    /// A readable name: the effect's, or `design:path` for a parameter.
+    pub fn label(&self) -> String {
+        match self.kind {
+            KnobKind::Effect => self.name.clone(),
+            KnobKind::Parameter => format!("{}:{}", self.design, self.name),
+        }
+    }
+
+    /// Value (the field's unit; nondimensional magnitude for effects) of a coordinate.
+    pub fn value(&self, x: f64) -> f64 {
+        if self.log { x.exp() } else { x }
+    }
+
+    /// SI value of a coordinate (the design at 1×).
+    pub fn si(&self, x: f64) -> f64 {
+        self.value(x) * self.si_per_value
+    }
+
+    /// The coordinate of a value.
+    pub fn coordinate(&self, value: f64) -> f64 {
+        if self.log { value.ln() } else { value }
+    }
+
+    /// Coordinate ↔ the unit interval the solvers work in.
+    pub fn to_unit(&self, x: f64) -> f64 {
+        (x - self.lo) / (self.hi - self.lo)
+    }
+    pub fn from_unit(&self, s: f64) -> f64 {
+        self.lo + s.clamp(0.0, 1.0) * (self.hi - self.lo)
+    }
+
+    /// The prior's χ² charge of a coordinate (0 without a prior).
+    pub fn prior_chi2(&self, x: f64) -> f64 {
+        match self.prior {
+            Some((mean, sd)) => ((self.value(x) - mean) / sd).powi(2),
+            None => 0.0,
+        }
+    }
+
+    /// Coordinates from the nominal (or off) toward the strongest setting: up from an off
+    /// value of 0 (or below the range), down from ∞ (or above), and from an off value inside
+    /// the range toward the lower end (for μ: slipperier). Parameters: toward the farther end.
+    pub fn strengthening_path(&self, steps: usize) -> Vec<f64> {
+        let (from, to) = match (self.kind, self.off_value, self.nominal) {
+            (KnobKind::Effect, Some(off), None) if off.is_infinite() || off.ln() > self.hi => {
+                (self.hi, self.lo)
+            }
+            (KnobKind::Effect, _, None) => (self.lo, self.hi),
+            (KnobKind::Effect, _, Some(x)) => (x, self.lo),
+            (KnobKind::Parameter, _, x) => {
+                let x = x.unwrap_or(self.lo);
+                if self.hi - x >= x - self.lo {
+                    (x, self.hi)
+                } else {
+                    (x, self.lo)
+                }
+            }
+        };
+        (0..=steps)
+            .map(|k| from + (to - from) * k as f64 / steps.max(1) as f64)
+            .collect()
+    }
+
+    /// Nodes of the knob's curve: `n` evenly spaced coordinates over its range, plus the
+    /// nominal if it lies inside (that walk is the nominal one).
+    pub fn nodes(&self, n: usize) -> Vec<f64> {
+        let n = n.max(2);
+        (0..n)
+            .map(|k| self.lo + (self.hi - self.lo) * k as f64 / (n - 1) as f64)
+            .collect()
+    }
+}
+
+/// The parameter values and effects of a model point, as the simulator takes them.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct ModelSetting {
+    /// (design name, path, value): applied to the trials of that design, on its 1× values.
+    pub params: Vec<(String, String, f64)>,
+    pub effects: Vec<EffectSetting>,
+}
+
+impl ModelSetting {
+    pub fn nominal() -> ModelSetting {
+        ModelSetting::default()
+    }
+
+    pub fn effect(e: EffectSetting) -> ModelSetting {
+        ModelSetting {
+            params: Vec::new(),
+            effects: vec![e],
+        }
+    }
+
+    /// The overrides that apply to design `design`.
+    pub fn params_of<'a>(&'a self, design: &'a str) -> impl Iterator<Item = (&'a str, f64)> {
+        self.params
+            .iter()
+            .filter(move |(d, _, _)| d == design)
+            .map(|(_, p, v)| (p.as_str(), *v))
+    }
+
+    /// A canonical key of what changes the walks of design `design` (the cache key).
+    pub fn key_for(&self, design: &str) -> String {
+        let mut parts: Vec<String> = self
+            .params_of(design)
+            .map(|(p, v)| format!("{p}={:016x}", v.to_bits()))
+            .collect();
+        parts.sort();
+        let mut effects: Vec<String> = self
+            .effects
+            .iter()
+            .map(|e| {
+                let mut k = e.effect.clone();
+                for v in &e.nondimensional {
+                    k.push_str(&format!(":{:016x}", v.to_bits()));
+                }
+                k
+            })
+            .collect();
+        effects.sort();
+        parts.extend(effects);
+        if parts.is_empty() {
+            "nominal".into()
+        } else {
+            parts.join(";")
+        }
+    }
+}
+
+/// The knobs of a diagnosis, parameters first, then effects.
+#[derive(Clone, Debug, Serialize)]
+pub struct Knobs {
+    pub list: Vec<Knob>,
+    /// Effects left out because a design declares their quantity uncertain (the parameter
+    /// is calibrated instead): (effect, the parameter that stands for it).
+    pub aliased: Vec<(String, String)>,
+}
+
+/// A point: a coordinate for every free knob, None for the others (nominal or off).
+pub type Point = Vec<Option<f64>>;
+
+impl Knobs {
+    /// The knobs for trials of `designs` (each scaled to 1× for the SI units): the designs'
+    /// uncertain parameters when `calibrate`, and the candidate `effects`. An effect that
+    /// replaces a design field (`replaces = "contact.friction_mu"`) which every design
+    /// declares uncertain is left out: calibrating the parameter is the same physics.
+    pub fn build(
+        designs: &[&Design],
+        effects: &[&EffectDef],
+        calibrate: bool,
+    ) -> Result<Knobs, crate::sim::SimError> {
+        let mut list = Vec::new();
+        if calibrate {
+            for d in designs {
+                for u in d.uncertain_params()? {
+                    let coord = |v: f64| if u.log { v.ln() } else { v };
+                    list.push(Knob {
+                        kind: KnobKind::Parameter,
+                        design: d.name.clone(),
+                        name: u.path.clone(),
+                        log: u.log,
+                        lo: coord(u.lo),
+                        hi: coord(u.hi),
+                        nominal: Some(coord(u.nominal)),
+                        off_value: None,
+                        prior: u.prior_sd.map(|sd| (u.nominal, sd)),
+                        si_per_value: 1.0,
+                        unit: String::new(),
+                        why: u.why.clone(),
+                    });
+                }
+            }
+        }
+        let mut aliased = Vec::new();
+        let first = designs.first().copied();
+        for def in effects {
+            if let Some(field) = &def.replaces
+                && !designs.is_empty()
+                && list
+                    .iter()
+                    .filter(|k| k.kind == KnobKind::Parameter && &k.name == field)
+                    .count()
+                    == designs.len()
+            {
+                aliased.push((def.name.clone(), field.clone()));
+                continue;
+            }
+            let p = def.magnitude();
+            let (nominal, si, off) = match first {
+                Some(d) => {
+                    let off = p.off_nondimensional(d, &def.name);
+                    let inside =
+                        off > 0.0 && off.is_finite() && (p.range[0]..=p.range[1]).contains(&off);
+                    (inside.then(|| off.ln()), p.scale.value(d), Some(off))
+                }
+                None => (None, 1.0, None),
+            };
+            list.push(Knob {
+                kind: KnobKind::Effect,
+                design: String::new(),
+                name: def.name.clone(),
+                log: true,
+                lo: p.range[0].ln(),
+                hi: p.range[1].ln(),
+                nominal,
+                off_value: off,
+                prior: None,
+                si_per_value: si,
+                unit: p.unit.clone(),
+                why: def.description.clone(),
+            });
+        }
+        Ok(Knobs { list, aliased })
+    }
+
+    pub fn len(&self) -> usize {
+        self.list.len()
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.list.is_empty()
+    }
+
+    /// The all-nominal point.
+    pub fn nominal_point(&self) -> Point {
+        vec![None; self.list.len()]
+    }
+
+    pub fn index_of(&self, label: &str) -> Option<usize> {
+        self.list.iter().position(|k| k.label() == label)
+    }
+
+    /// The simulator's setting of a point. A knob at exactly its nominal coordinate is the
+    /// nominal model (same walks, same cache key).
+    pub fn setting(&self, lib: &EffectLibrary, point: &[Option<f64>]) -> ModelSetting {
+        let mut s = ModelSetting::default();
+        for (k, x) in self.list.iter().zip(point) {
+            let Some(x) = *x else { continue };
+            if k.nominal == Some(x) {
+                continue;
+            }
+            match k.kind {
+                KnobKind::Parameter => {
+                    s.params
+                        .push((k.design.clone(), k.name.clone(), k.value(x)));
+                }
+                KnobKind::Effect => {
+                    if let Ok(def) = lib.get(&k.name) {
+                        s.effects.push(def.setting(k.value(x)));
+                    }
+                }
+            }
+        }
+        s
+    }
+
+    /// The prior's χ² charge of a point.
+    pub fn prior_chi2(&self, point: &[Option<f64>]) -> f64 {
+        self.list
+            .iter()
+            .zip(point)
+            .filter_map(|(k, x)| x.map(|x| k.prior_chi2(x)))
+            .sum()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::gap::library::EffectLibrary;
+
+    /// The knobs of the bundled Mugatu: its declared parameters (nominal inside the range),
+    /// then the effects — damping (off = 0) strengthening upward, the motor line (off = ∞)
+    /// downward — and friction_coefficient left out because the design calibrates μ.
+    #[test]
+    fn mugatu_knobs_and_their_directions() {
+        let lib = EffectLibrary::bundled().expect("library");
+        let d = Design::builtin("mugatu").expect("mugatu");
+        let effects: Vec<&EffectDef> = lib.effects.iter().collect();
+        let k = Knobs::build(&[&d], &effects, true).expect("knobs");
+        let n_params = d.uncertain.len();
+        assert!(
+            k.list[..n_params]
+                .iter()
+                .all(|x| x.kind == KnobKind::Parameter)
+        );
+        assert_eq!(
+            k.aliased,
+            vec![(
+                "friction_coefficient".to_string(),
+                "contact.friction_mu".to_string()
+            )]
+        );
+        let slope = &k.list[k.index_of("mugatu:ground.slope_deg").expect("slope")];
+        assert_eq!((slope.lo, slope.hi, slope.nominal), (-3.0, 3.0, Some(0.0)));
+        assert_eq!(slope.prior_chi2(2.0), 4.0, "sd 1 deg: 2 deg costs 2²");
+        let damping = &k.list[k.index_of("hip_viscous_damping").expect("damping")];
+        let path = damping.strengthening_path(4);
+        assert!(path[0] < path[4] && damping.nominal.is_none());
+        let motor = &k.list[k.index_of("motor_torque_speed").expect("motor")];
+        let path = motor.strengthening_path(4);
+        assert!(path[0] > path[4], "a slower motor is a stronger effect");
+        // Coordinates: ln for effects; a knob at its nominal is the nominal model.
+        assert!((damping.value(damping.coordinate(0.02)) - 0.02).abs() < 1e-15);
+        let mut p = k.nominal_point();
+        p[k.index_of("mugatu:ground.slope_deg").expect("slope")] = Some(0.0);
+        assert_eq!(k.setting(&lib, &p), ModelSetting::nominal());
+        let off = Knobs::build(&[&d], &effects, false).expect("no calibration");
+        assert!(off.list.iter().all(|x| x.kind == KnobKind::Effect));
+        assert!(off.aliased.is_empty(), "without calibration μ is an effect");
+    }
+}

@@ -1,0 +1,145 @@
+//! Solvers for the fits: argmin's Nelder–Mead from several starts on the surrogate's χ²
+//! (cheap: no walks), and a grid scan for one coordinate (the starts, the profiles and the
+//! group refits).
+//!
+//! Why Nelder–Mead (argmin): the cost is a sum of squares of monotone cubic interpolants,
+//! continuous with kinks where a knob's curve crosses a node, bounded, and a few to a dozen
+//! dimensions; the solver needs no gradient and tolerates the kinks. Multi-start covers the
+//! non-convexity an effect's curve can bring (μ, a latency that makes a walker walk). The
+//! comparison with other solvers is in reports/gap-solvers.md.
+
+use argmin::core::{Executor, State};
+use argmin::solver::neldermead::NelderMead;
+
+use super::problem::Objective;
+
+/// Evaluations allowed per start: generous for ≤ 12 dimensions.
+fn max_iters(dim: usize) -> u64 {
+    (200 + 150 * dim) as u64
+}
+
+/// Minimises the objective over the unit box from each start (unit coordinates), with an
+/// initial simplex of edge `step`; returns the best (point in the box, cost).
+pub fn minimize(obj: &Objective<'_>, starts: &[Vec<f64>], step: f64) -> (Vec<f64>, f64) {
+    let dim = obj.active.len();
+    if dim == 0 {
+        return (Vec::new(), obj.value(&[]));
+    }
+    let mut best: Option<(Vec<f64>, f64)> = None;
+    for start in starts {
+        let s0: Vec<f64> = start.iter().map(|v| v.clamp(0.0, 1.0)).collect();
+        let (s, f) = nelder_mead(obj, &s0, step, max_iters(dim));
+        if best.as_ref().is_none_or(|(_, bf)| f < *bf) {
+            best = Some((s, f));
+        }
+    }
+    let (s, _) = best.unwrap_or_else(|| (vec![0.5; dim], f64::INFINITY));
+    // One restart from the best point with a fresh simplex: Nelder–Mead's simplex can
+    // collapse before the minimum in several dimensions (Lagarias et al. 1998).
+    let s: Vec<f64> = s.iter().map(|v| v.clamp(0.0, 1.0)).collect();
+    let (s, _) = if dim > 1 {
+        nelder_mead(obj, &s, step / 2.0, max_iters(dim))
+    } else {
+        (s.clone(), obj.value(&s))
+    };
+    let s: Vec<f64> = s.iter().map(|v| v.clamp(0.0, 1.0)).collect();
+    let f = obj.value(&s);
+    (s, f)
+}
+
+fn nelder_mead(obj: &Objective<'_>, s0: &[f64], step: f64, iters: u64) -> (Vec<f64>, f64) {
+    let dim = s0.len();
+    let mut simplex = vec![s0.to_vec()];
+    for i in 0..dim {
+        let mut v = s0.to_vec();
+        // Step into the box.
+        v[i] = if v[i] + step <= 1.0 {
+            v[i] + step
+        } else {
+            v[i] - step
+        };
+        simplex.push(v);
+    }
+    let f0 = obj.value(s0);
+    let solver = match NelderMead::new(simplex).with_sd_tolerance(1e-9) {
+        Ok(s) => s,
+        Err(_) => return (s0.to_vec(), f0),
+    };
+    match Executor::new(obj.clone(), solver)
+        .configure(|state| state.max_iters(iters))
+        .run()
+    {
+        Ok(res) => {
+            let state = res.state();
+            match state.get_best_param() {
+                Some(p) if state.get_best_cost() < f0 => (p.clone(), state.get_best_cost()),
+                _ => (s0.to_vec(), f0),
+            }
+        }
+        Err(_) => (s0.to_vec(), f0),
+    }
+}
+
+/// Scans unit coordinate `i` of the active knobs over `n` evenly spaced values with the
+/// others at `s`: the values and costs.
+pub fn scan(obj: &Objective<'_>, s: &[f64], i: usize, n: usize) -> Vec<(f64, f64)> {
+    let n = n.max(2);
+    (0..n)
+        .map(|k| {
+            let t = k as f64 / (n - 1) as f64;
+            let mut v = s.to_vec();
+            v[i] = t;
+            (t, obj.value(&v))
+        })
+        .collect()
+}
+
+/// The local minima of a scan, best first (at most `k`).
+pub fn scan_minima(scan: &[(f64, f64)], k: usize) -> Vec<f64> {
+    let mut minima: Vec<(f64, f64)> = Vec::new();
+    for j in 0..scan.len() {
+        let left = if j > 0 { scan[j - 1].1 } else { f64::INFINITY };
+        let right = scan.get(j + 1).map(|p| p.1).unwrap_or(f64::INFINITY);
+        if scan[j].1 <= left && scan[j].1 <= right {
+            minima.push(scan[j]);
+        }
+    }
+    minima.sort_by(|a, b| a.1.total_cmp(&b.1));
+    minima.into_iter().take(k).map(|m| m.0).collect()
+}
+
+/// Minimises coordinate `i` alone (others at `s`): the best of a scan, polished by golden
+/// section between its neighbours. Returns (value in [0, 1], cost).
+pub fn minimize_1d(obj: &Objective<'_>, s: &[f64], i: usize, n: usize) -> (f64, f64) {
+    let sc = scan(obj, s, i, n);
+    let Some(j) = (0..sc.len()).min_by(|a, b| sc[*a].1.total_cmp(&sc[*b].1)) else {
+        return (s[i], f64::INFINITY);
+    };
+    let h = 1.0 / (sc.len() - 1) as f64;
+    let (mut a, mut b) = ((sc[j].0 - h).max(0.0), (sc[j].0 + h).min(1.0));
+    let f = |t: f64| {
+        let mut v = s.to_vec();
+        v[i] = t;
+        obj.value(&v)
+    };
+    let g = (5f64.sqrt() - 1.0) / 2.0;
+    let (mut c, mut d) = (b - g * (b - a), a + g * (b - a));
+    let (mut fc, mut fd) = (f(c), f(d));
+    for _ in 0..30 {
+        if fc < fd {
+            b = d;
+            d = c;
+            fd = fc;
+            c = b - g * (b - a);
+            fc = f(c);
+        } else {
+            a = c;
+            c = d;
+            fc = fd;
+            d = a + g * (b - a);
+            fd = f(d);
+        }
+    }
+    let (t, ft) = if fc < fd { (c, fc) } else { (d, fd) };
+    if ft < sc[j].1 { (t, ft) } else { sc[j] }
+}

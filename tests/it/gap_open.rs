@@ -1,0 +1,435 @@
+//! The gap diagnosis outside its closed world: a nominal parameter of the design that is
+//! wrong (declared uncertain, or not), two effects at once, and trials made by another
+//! engine (Drake). The small cases run on a test design with two uncertain parameters
+//! (`tests/data/gap/mugatu-two-uncertain.toml`) over six conditions.
+
+use std::sync::OnceLock;
+
+use robot_survey::gap::EffectLibrary;
+use robot_survey::gap::benchmark::{BenchmarkOptions, CaseRow, summarize};
+use robot_survey::gap::cache::SimCache;
+use robot_survey::gap::diagnose::{AnswerKind, DiagnoseOptions, Diagnosis, diagnose_conditions};
+use robot_survey::gap::knob::ModelSetting;
+use robot_survey::gap::simulate::{Condition, resolve};
+use robot_survey::gap::synth::{add_noise, truth_metrics};
+use robot_survey::gap::trials::{Metric, TrialSet};
+use robot_survey::sim::Design;
+
+use super::common::{repo, stderr, survey};
+
+const TEST_DESIGN: &str = "mugatu-two-uncertain";
+
+struct Six {
+    lib: EffectLibrary,
+    base: TrialSet,
+    conditions: Vec<Condition>,
+    cache: SimCache,
+}
+
+fn six() -> &'static Six {
+    static S: OnceLock<Six> = OnceLock::new();
+    S.get_or_init(|| {
+        let base =
+            TrialSet::read(&repo().join("tests/data/gap/conditions-6.csv")).expect("conditions");
+        let conditions = resolve(&base).expect("resolve");
+        Six {
+            lib: EffectLibrary::bundled().expect("library"),
+            base,
+            conditions,
+            cache: SimCache::default(),
+        }
+    })
+}
+
+/// Trials of the six conditions with `params` (path, value at 1×) and `effects` (name, SI
+/// at 1×), `noise` relative sd; diagnosed with `candidates` as the effect library.
+fn case(
+    params: &[(&str, f64)],
+    effects: &[(&str, f64)],
+    noise: f64,
+    seed: u64,
+    candidates: &[&str],
+    calibrate: bool,
+) -> Diagnosis {
+    let s = six();
+    let design = &s.conditions[0].design;
+    let mut setting = ModelSetting::nominal();
+    for (p, v) in params {
+        setting
+            .params
+            .push((design.name.clone(), p.to_string(), *v));
+    }
+    for (e, si) in effects {
+        let def = s.lib.get(e).expect("effect");
+        let mut set = def.setting(def.magnitude().default);
+        set.nondimensional[0] = si / def.magnitude().scale.value(design);
+        setting.effects.push(set);
+    }
+    let truth = truth_metrics(&s.conditions, &s.lib, &setting, &|| {}).expect("truth");
+    let set = TrialSet {
+        origin: "synthetic".into(),
+        base_dir: s.base.base_dir.clone(),
+        trials: add_noise(&s.base.trials, &truth, noise, seed, "test"),
+    };
+    let opts = DiagnoseOptions {
+        effects: candidates.iter().map(|e| e.to_string()).collect(),
+        calibrate,
+        explanations: false,
+        identifiability: false,
+        ..DiagnoseOptions::default()
+    };
+    diagnose_conditions(&set, &s.conditions, &s.lib, &opts, &s.cache, &|_| {})
+        .expect("diagnosis")
+        .0
+}
+
+fn names(d: &Diagnosis) -> (Vec<String>, Vec<String>) {
+    (
+        d.answer.parameters.iter().map(|n| n.knob.clone()).collect(),
+        d.answer.effects.iter().map(|n| n.knob.clone()).collect(),
+    )
+}
+
+#[test]
+fn uncertain_declarations_are_checked_and_name_the_entry() {
+    let base = std::fs::read_to_string(repo().join("dataset/walkers/mugatu.toml")).expect("read");
+    let body = &base[..base
+        .find("[[uncertain]]")
+        .expect("mugatu declares uncertain values")];
+    let cases = [
+        (
+            "[[uncertain]]\npath = \"mass.no_such_field\"\nrange = [0.1, 0.2]\nwhy = \"x\"\n",
+            "uncertain[0] (mass.no_such_field)",
+            "no field `no_such_field`",
+        ),
+        (
+            "[[uncertain]]\npath = \"mass.leg_com_height_over_l\"\nrange = [0.5, 0.6]\nwhy = \"x\"\n",
+            "uncertain[0] (mass.leg_com_height_over_l)",
+            "must lie in its plausible range",
+        ),
+        (
+            "[[uncertain]]\npath = \"mass.leg_com_height_over_l\"\nrange = [0.3, 1.2]\nwhy = \"x\"\n",
+            "uncertain[0] (mass.leg_com_height_over_l)",
+            "not a valid design",
+        ),
+        (
+            "[[uncertain]]\npath = \"ground.slope_deg\"\nrelative_sd = 0.1\nwhy = \"x\"\n",
+            "uncertain[0] (ground.slope_deg)",
+            "the file's value is 0",
+        ),
+        (
+            "[[uncertain]]\npath = \"mass.leg_com_height_over_l\"\nrange = [0.4, 0.5]\nwhy = \" \"\n",
+            "uncertain[0].why",
+            "say why",
+        ),
+        (
+            "[[uncertain]]\npath = \"mass.leg_inertia_box_over_l[3]\"\nrange = [0.4, 0.5]\nwhy = \"x\"\n",
+            "uncertain[0] (mass.leg_inertia_box_over_l[3])",
+            "has no element 3",
+        ),
+    ];
+    for (entry, field, why) in cases {
+        let text = format!("{body}\n{entry}");
+        let e = Design::from_toml_str(&text, "m.toml")
+            .expect_err(entry)
+            .to_string();
+        assert!(
+            e.contains("m.toml") && e.contains(field) && e.contains(why),
+            "{e}"
+        );
+    }
+    // A declared value moves only its own number; the range is checked in field units.
+    let d = Design::builtin("mugatu").expect("mugatu");
+    let moved = d
+        .with_value("mass.leg_inertia_box_over_l[0]", 0.9)
+        .expect("valid");
+    assert_eq!(moved.mass.leg_inertia_box_over_l, [0.9, 0.2, 1.0]);
+    assert_eq!(moved.geometry, d.geometry);
+    assert_eq!(moved.contact, d.contact);
+    let e = d
+        .with_value("mass.leg_com_height_over_l", 1.5)
+        .expect_err("COM above the hip");
+    assert!(e.to_string().contains("mass.leg_com_height_over_l"), "{e}");
+    let u = d.uncertain_params().expect("resolved");
+    let slope = u
+        .iter()
+        .find(|p| p.path == "ground.slope_deg")
+        .expect("slope declared");
+    assert_eq!(
+        (slope.nominal, slope.lo, slope.hi, slope.prior_sd),
+        (0.0, -3.0, 3.0, Some(1.0))
+    );
+}
+
+#[test]
+fn cli_synth_set_names_a_bad_path() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let out = dir.path().join("t.csv");
+    let o = survey(&[
+        "gap",
+        "synth",
+        "--set",
+        "mass.no_such=1",
+        "--out",
+        out.to_str().expect("utf-8"),
+    ]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(
+        stderr(&o).contains("--set mass.no_such=1"),
+        "{}",
+        stderr(&o)
+    );
+    assert!(!out.exists(), "nothing written on error");
+}
+
+/// A known error of a declared parameter (an unreported 1.5° slope) is named as that
+/// parameter, no effect is blamed, and its 95 % interval holds the truth.
+#[test]
+fn calibration_recovers_a_declared_parameter_error() {
+    let d = case(
+        &[("ground.slope_deg", 1.5)],
+        &[],
+        0.03,
+        5,
+        &["hip_coulomb_friction", "rolling_resistance"],
+        true,
+    );
+    let (params, effects) = names(&d);
+    assert!(effects.is_empty(), "no effect: {}", d.answer.statement);
+    assert_eq!(
+        params,
+        vec![format!("{TEST_DESIGN}:ground.slope_deg")],
+        "{}",
+        d.answer.statement
+    );
+    assert_eq!(
+        d.answer.kind,
+        AnswerKind::ParametersOff,
+        "{}",
+        d.answer.statement
+    );
+    let [lo, hi] = d.answer.parameters[0].interval;
+    assert!(lo <= 1.5 && 1.5 <= hi, "truth 1.5 outside [{lo}, {hi}]");
+}
+
+/// An error in a value the design does not declare uncertain (its mass, [PAPER]) shows in
+/// the peak torque only; nothing may be named for it.
+#[test]
+fn an_undeclared_parameter_error_is_not_blamed_on_anything() {
+    let d = case(
+        &[("mass.total_mass_kg", 1.08)],
+        &[],
+        0.03,
+        6,
+        &["hip_coulomb_friction", "rolling_resistance"],
+        true,
+    );
+    let (params, effects) = names(&d);
+    assert!(
+        params.is_empty() && effects.is_empty(),
+        "{}",
+        d.answer.statement
+    );
+    assert_ne!(
+        d.answer.kind,
+        AnswerKind::WithinNoise,
+        "a 20 % mass error is a real gap"
+    );
+    let torque = d
+        .where_
+        .iter()
+        .find(|g| g.metric == Metric::PeakTorqueNm)
+        .expect("torque measured");
+    assert!(
+        torque.significant && torque.mean_relative_pct < -10.0,
+        "{}",
+        torque.statement
+    );
+}
+
+/// Two library effects at once (the nominal taken as right): both are named.
+#[test]
+fn two_effects_at_once_are_both_named() {
+    let d = case(
+        &[],
+        &[("hip_coulomb_friction", 0.03), ("soft_ground", 4.0e6)],
+        0.03,
+        7,
+        &["hip_coulomb_friction", "hip_viscous_damping", "soft_ground"],
+        false,
+    );
+    let (params, mut effects) = names(&d);
+    effects.sort();
+    assert!(params.is_empty());
+    assert_eq!(
+        effects,
+        vec!["hip_coulomb_friction", "soft_ground"],
+        "{}",
+        d.answer.statement
+    );
+    assert_eq!(d.chain.len(), 2, "{}", d.answer.statement);
+}
+
+/// Trials made by Drake on the reference design, no effect added (the committed golden file
+/// `tests/golden/drake/gap/trials-none.csv`, made by the command in its README), plus 3 %
+/// noise: the engines' difference must not be blamed on a physical effect.
+#[test]
+fn a_drake_made_null_case_is_not_blamed_on_an_effect() {
+    let lib = EffectLibrary::bundled().expect("library");
+    let golden =
+        TrialSet::read(&repo().join("tests/golden/drake/gap/trials-none.csv")).expect("golden");
+    let conditions = resolve(&golden).expect("resolve");
+    let truth: Vec<_> = golden
+        .trials
+        .iter()
+        .map(|t| {
+            let mut values = [f64::NAN; 8];
+            for m in Metric::SIMULATED {
+                if let Some(v) = t.measured(m) {
+                    values[m.index()] = v.value;
+                }
+            }
+            robot_survey::gap::simulate::SimMetrics {
+                values,
+                fell: false,
+            }
+        })
+        .collect();
+    let set = TrialSet {
+        origin: "drake null".into(),
+        base_dir: golden.base_dir.clone(),
+        trials: add_noise(&golden.trials, &truth, 0.03, 3, "drake"),
+    };
+    let opts = DiagnoseOptions {
+        effects: vec![
+            "actuation_latency".into(),
+            "hip_viscous_damping".into(),
+            "hip_coulomb_friction".into(),
+        ],
+        explanations: false,
+        identifiability: false,
+        ..DiagnoseOptions::default()
+    };
+    let (d, _) = diagnose_conditions(
+        &set,
+        &conditions,
+        &lib,
+        &opts,
+        &SimCache::default(),
+        &|_| {},
+    )
+    .expect("diagnosis");
+    assert!(!d.within_noise, "the engines differ: a real gap");
+    assert!(
+        d.answer.effects.is_empty(),
+        "an effect blamed: {}",
+        d.answer.statement
+    );
+}
+
+fn row(
+    kind: &str,
+    truth_effects: &str,
+    truth_params: &str,
+    named_effects: &str,
+    named_params: &str,
+    intervals: &str,
+) -> CaseRow {
+    CaseRow {
+        key: format!("{kind}/{truth_effects}/{truth_params}/{named_effects}/{named_params}"),
+        suite: "main".into(),
+        kind: kind.into(),
+        noise: 0.05,
+        seed: 0,
+        calibrate: true,
+        multiple: None,
+        truth_effects: truth_effects.into(),
+        truth_params: truth_params.into(),
+        truth_declared: !truth_params.is_empty() && !truth_params.starts_with("mass.total"),
+        answer: String::new(),
+        named_effects: named_effects.into(),
+        named_params: named_params.into(),
+        intervals: intervals.into(),
+        ambiguous: String::new(),
+        leads: String::new(),
+        gap_before: 1.0,
+        gap_after: None,
+        walks: 0,
+    }
+}
+
+/// The benchmark's scores on hand-made case rows: counts, rates and Clopper–Pearson bounds
+/// as computed by hand (0 of 300: upper bound 0.99361 %, R's qbeta(0.95, 1, 300)).
+#[test]
+fn benchmark_scores_count_what_the_rows_say() {
+    let lib = EffectLibrary::bundled().expect("library");
+    let mut rows: Vec<CaseRow> = (0..300)
+        .map(|i| {
+            let mut r = row("null", "", "", "", "", "");
+            r.key = format!("null/{i}");
+            r
+        })
+        .collect();
+    rows.push(row(
+        "pair",
+        "hip_coulomb_friction=0.02;soft_ground=3000000",
+        "",
+        "hip_coulomb_friction;soft_ground",
+        "",
+        "",
+    ));
+    rows.push(row(
+        "pair",
+        "hip_coulomb_friction=0.02;rolling_resistance=0.002",
+        "",
+        "hip_coulomb_friction;hip_backlash",
+        "",
+        "",
+    ));
+    // friction_coefficient is named through the parameter it stands for in mugatu.
+    rows.push(row(
+        "pair",
+        "friction_coefficient=0.3;soft_ground=3000000",
+        "",
+        "soft_ground",
+        "mugatu:contact.friction_mu",
+        "",
+    ));
+    rows.push(row(
+        "parameter",
+        "",
+        "ground.slope_deg=1.5",
+        "",
+        "mugatu:ground.slope_deg",
+        "mugatu:ground.slope_deg=1.2..1.8",
+    ));
+    rows.push(row(
+        "parameter",
+        "",
+        "mass.total_mass_kg=1.08",
+        "rolling_resistance",
+        "mugatu:ground.slope_deg",
+        "",
+    ));
+    let opts = BenchmarkOptions::standard("mugatu");
+    let s = summarize(&rows, &lib, &opts, Default::default());
+    let get = |what: &str| {
+        s.scores
+            .iter()
+            .find(|x| x.what.starts_with(what))
+            .unwrap_or_else(|| panic!("no score {what}"))
+    };
+    let fa = get("main: false alarms");
+    assert_eq!((fa.k, fa.n), (0, 300));
+    assert!((fa.upper_95 - 0.0099361).abs() < 1e-6, "{}", fa.upper_95);
+    let both = get("pairs of effects");
+    assert_eq!((both.k, both.n), (2, 3));
+    let third = get("pairs: a spurious third");
+    assert_eq!((third.k, third.n), (1, 3));
+    let wrong_effect = get("main: parameter errors: a library effect wrongly called");
+    assert_eq!((wrong_effect.k, wrong_effect.n), (1, 2));
+    let wrong_param = get("main: parameter errors: a wrong parameter named");
+    assert_eq!((wrong_param.k, wrong_param.n), (1, 2));
+    let cov = get("95 % intervals holding the truth");
+    assert_eq!((cov.k, cov.n), (1, 1));
+}
