@@ -26,6 +26,10 @@ pub enum GapCommand {
     /// Where the simulation misses the trials, which effect explains it, how far the gap
     /// shrinks on held-out conditions.
     Diagnose(DiagnoseArgs),
+    /// Which settings of the designs' declared uncertain parameters fit the trials at all:
+    /// a Latin hypercube over their whole ranges (history matching), what each parameter
+    /// is pinned to, and how far each measured metric can be reached.
+    Explore(ExploreArgs),
     /// Every effect at several magnitudes × noise levels × seeds, plus null cases:
     /// identification confusion matrix, parameter recovery, shrink.
     Benchmark(BenchmarkArgs),
@@ -116,6 +120,29 @@ pub struct DiagnoseArgs {
 
 #[derive(Args, Debug)]
 #[command(after_help = "Examples:\n  \
+survey gap explore --trials dataset/trials/zippy-calibration.csv --samples 512\n  \
+survey gap explore --trials dataset/trials/zippy-top-speed.csv --format json\n\n\
+A setting is plausible when its χ² against the trials has p ≥ 0.05 (χ² with one degree of freedom \
+per measurement). Every sample walks every condition of the trials file; the sample is \
+deterministic in --seed.")]
+pub struct ExploreArgs {
+    /// Trials CSV (format: dataset/trials/README.md); its designs must declare [[uncertain]].
+    #[arg(long, value_name = "FILE")]
+    pub trials: PathBuf,
+    /// Parameter settings walked (Latin hypercube).
+    #[arg(long, default_value_t = 256)]
+    pub samples: usize,
+    #[arg(long, default_value_t = 1)]
+    pub seed: u64,
+    /// Relative sd assumed where a measurement states none.
+    #[arg(long, default_value_t = 0.10)]
+    pub default_sd: f64,
+    #[arg(long, value_enum, default_value_t)]
+    pub format: GapFormat,
+}
+
+#[derive(Args, Debug)]
+#[command(after_help = "Examples:\n  \
 survey gap benchmark --drake tests/golden/drake/gap --points bench.csv --out reports/\n  \
 survey gap benchmark --drake tests/golden/drake/gap --points b-2.csv --shard 2/4   # one slice\n  \
 survey gap benchmark --drake tests/golden/drake/gap --merge b-1.csv b-2.csv b-3.csv b-4.csv --points bench.csv --out reports/\n  \
@@ -154,6 +181,11 @@ pub struct BenchmarkArgs {
     /// Points files of shards to merge into --points (no cases are run).
     #[arg(long, num_args = 1.., value_name = "FILE")]
     pub merge: Vec<PathBuf>,
+    /// Run only the cases of these kinds (null, effect, pair, parameter, drake), e.g. to
+    /// spend a short session on the pairs: the points file stays the same benchmark's, and
+    /// the report scores every row it holds. With --shard, slices are taken after the filter.
+    #[arg(long, value_delimiter = ',', value_name = "KIND")]
+    pub kinds: Vec<String>,
     /// Folder for gap-benchmark.md, .json and .svg.
     #[arg(long, value_name = "DIR", default_value = "reports")]
     pub out: PathBuf,
@@ -164,6 +196,7 @@ pub fn run(a: &GapArgs) -> anyhow::Result<ExitCode> {
         GapCommand::Effects(e) => effects(e),
         GapCommand::Synth(s) => synth(s),
         GapCommand::Diagnose(d) => diagnose(d),
+        GapCommand::Explore(e) => explore(e),
         GapCommand::Benchmark(b) => benchmark(b),
     }
 }
@@ -289,6 +322,32 @@ fn diagnose(a: &DiagnoseArgs) -> anyhow::Result<ExitCode> {
     Ok(ExitCode::SUCCESS)
 }
 
+fn explore(a: &ExploreArgs) -> anyhow::Result<ExitCode> {
+    let lib = EffectLibrary::bundled()?;
+    let set = TrialSet::read(&a.trials)?;
+    let conditions = gap::simulate::resolve(&set)?;
+    let opts = gap::explore::ExploreOptions {
+        samples: a.samples,
+        seed: a.seed,
+        default_relative_sd: a.default_sd,
+    };
+    let pb = bar((a.samples * conditions.len()) as u64, "exploring");
+    let e = gap::explore::explore(
+        &set,
+        &conditions,
+        &lib,
+        &opts,
+        &gap::cache::SimCache::default(),
+        &|| pb.inc(1),
+    )?;
+    pb.finish_and_clear();
+    print(&match a.format {
+        GapFormat::Json => report::json(&e)?,
+        GapFormat::Text => report::gap::exploration_md(&e),
+    });
+    Ok(ExitCode::SUCCESS)
+}
+
 fn benchmark(a: &BenchmarkArgs) -> anyhow::Result<ExitCode> {
     use robot_survey::checkpoint::Shard;
     let lib = EffectLibrary::bundled()?;
@@ -323,7 +382,17 @@ fn benchmark(a: &BenchmarkArgs) -> anyhow::Result<ExitCode> {
     pb.enable_steady_tick(std::time::Duration::from_millis(250));
     let progress = |what: &str| pb.set_message(what.to_string());
     progress("planning: thresholds and cases");
-    let plan = gap::benchmark::plan(&lib, &opts, &progress)?;
+    let mut plan = gap::benchmark::plan(&lib, &opts, &progress)?;
+    const KINDS: [&str; 5] = ["null", "effect", "pair", "parameter", "drake"];
+    if let Some(bad) = a.kinds.iter().find(|k| !KINDS.contains(&k.as_str())) {
+        anyhow::bail!(
+            "--kinds {bad}: not a case kind (one of {})",
+            KINDS.join(", ")
+        );
+    }
+    if !a.kinds.is_empty() {
+        plan.cases.retain(|c| a.kinds.contains(&c.kind));
+    }
     let rows = if a.merge.is_empty() {
         gap::benchmark::run(&lib, &opts, &plan, a.points.as_deref(), shard, &progress)?
     } else {

@@ -11,9 +11,12 @@ use super::knob::ModelSetting;
 use super::library::EffectLibrary;
 use super::simulate::{Condition, SimMetrics, simulate_jobs};
 
+/// Walk metrics by (condition index, setting key).
+type WalkMap = HashMap<(usize, String), SimMetrics>;
+
 #[derive(Default)]
 pub struct SimCache {
-    map: Mutex<HashMap<(usize, String), SimMetrics>>,
+    map: Mutex<WalkMap>,
     walks: AtomicUsize,
 }
 
@@ -125,9 +128,7 @@ impl SimCache {
             .collect()
     }
 
-    fn lock(
-        &self,
-    ) -> Result<std::sync::MutexGuard<'_, HashMap<(usize, String), SimMetrics>>, GapError> {
+    fn lock(&self) -> Result<std::sync::MutexGuard<'_, WalkMap>, GapError> {
         self.map
             .lock()
             .map_err(|_| GapError::Invalid("a worker panicked while holding the walk cache".into()))

@@ -209,7 +209,7 @@ pub struct Timing {
 
 /// Trials whose `trajectory` file is given get the metrics they lack measured from it, by
 /// the code that measures the simulator's walks (`sim::report_from_trajectory`).
-fn fill_from_trajectories(
+pub fn fill_from_trajectories(
     set: &TrialSet,
     conditions: &[Condition],
     lib: &EffectLibrary,

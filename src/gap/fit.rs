@@ -90,7 +90,7 @@ pub fn dispersion(chi2_data: f64, n: usize, k: usize) -> f64 {
 /// over-dispersion `phi` of the larger model (residual dof `dof`): χ²_df when phi = 1, else
 /// the F(df, dof) of the quasi-likelihood.
 pub fn lr_p_value(lr: f64, df: usize, phi: f64, dof: usize) -> f64 {
-    if !(lr > 0.0) || df == 0 {
+    if lr.is_nan() || lr <= 0.0 || df == 0 {
         return 1.0;
     }
     if !phi.is_finite() || dof == 0 {
@@ -210,7 +210,6 @@ impl<'a> FitContext<'a> {
         };
         let (s, _) = minimize(&obj, &unit_starts, 0.12);
         let point = obj.point(&s);
-        drop(obj);
         drop(sur);
         self.surrogate_fit(active, point, s, correction)
     }
@@ -546,10 +545,7 @@ impl<'a> FitContext<'a> {
             has_obs[o.trial] = true;
         }
         let mut total = 0.0;
-        for c in 0..self.conditions.len() {
-            if !has_obs[c] {
-                continue;
-            }
+        for (c, _) in has_obs.iter().enumerate().filter(|(_, seen)| **seen) {
             let mut obj = self.objective(&sur, &fit.active, &fit.point, &fit.correction);
             obj.skip = Some(c);
             let (s, _) = minimize(&obj, std::slice::from_ref(&fit.unit), 0.05);
@@ -880,11 +876,14 @@ fn bracket_profile(
     Ok((lo, open_below, hi, open_above))
 }
 
+/// A label of a condition by one of its columns.
+type ConditionKey = Box<dyn Fn(&Condition) -> String>;
+
 /// Groupings of the conditions by each condition column that takes two or more values:
 /// size, drive frequency relative to the design's own at that size, amplitude, mass,
 /// slope. Each is (column, group index per condition).
 pub fn groupings(conditions: &[Condition]) -> Vec<(String, Vec<usize>)> {
-    let keys: Vec<(&str, Box<dyn Fn(&Condition) -> String>)> = vec![
+    let keys: Vec<(&str, ConditionKey)> = vec![
         (
             "leg length",
             Box::new(|c: &Condition| format!("{}:{:.4e}", c.design.name, c.leg_length_m)),
@@ -914,7 +913,7 @@ pub fn groupings(conditions: &[Condition]) -> Vec<(String, Vec<usize>)> {
     ];
     let mut out = Vec::new();
     for (name, key) in keys {
-        let labels: Vec<String> = conditions.iter().map(|c| key(c)).collect();
+        let labels: Vec<String> = conditions.iter().map(&key).collect();
         let mut distinct: Vec<&String> = labels.iter().collect();
         distinct.sort();
         distinct.dedup();

@@ -25,6 +25,7 @@ pub mod cache;
 pub mod curve;
 pub mod diagnose;
 pub mod error;
+pub mod explore;
 pub mod fit;
 pub mod identify;
 pub mod knob;

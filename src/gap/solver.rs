@@ -6,7 +6,10 @@
 //! continuous with kinks where a knob's curve crosses a node, bounded, and a few to a dozen
 //! dimensions; the solver needs no gradient and tolerates the kinks. Multi-start covers the
 //! non-convexity an effect's curve can bring (μ, a latency that makes a walker walk). The
-//! comparison with other solvers is in reports/gap-solvers.md.
+//! solver is not where the time goes: a diagnosis spends > 95 % of it in walks
+//! (reports/gap-speed.md), and every surrogate evaluation is microseconds, so a
+//! population method (argmin's particle swarm, CMA-ES) would buy robustness at no walk
+//! cost but has not been measured against this one here.
 
 use argmin::core::{Executor, State};
 use argmin::solver::neldermead::NelderMead;
@@ -106,40 +109,4 @@ pub fn scan_minima(scan: &[(f64, f64)], k: usize) -> Vec<f64> {
     }
     minima.sort_by(|a, b| a.1.total_cmp(&b.1));
     minima.into_iter().take(k).map(|m| m.0).collect()
-}
-
-/// Minimises coordinate `i` alone (others at `s`): the best of a scan, polished by golden
-/// section between its neighbours. Returns (value in [0, 1], cost).
-pub fn minimize_1d(obj: &Objective<'_>, s: &[f64], i: usize, n: usize) -> (f64, f64) {
-    let sc = scan(obj, s, i, n);
-    let Some(j) = (0..sc.len()).min_by(|a, b| sc[*a].1.total_cmp(&sc[*b].1)) else {
-        return (s[i], f64::INFINITY);
-    };
-    let h = 1.0 / (sc.len() - 1) as f64;
-    let (mut a, mut b) = ((sc[j].0 - h).max(0.0), (sc[j].0 + h).min(1.0));
-    let f = |t: f64| {
-        let mut v = s.to_vec();
-        v[i] = t;
-        obj.value(&v)
-    };
-    let g = (5f64.sqrt() - 1.0) / 2.0;
-    let (mut c, mut d) = (b - g * (b - a), a + g * (b - a));
-    let (mut fc, mut fd) = (f(c), f(d));
-    for _ in 0..30 {
-        if fc < fd {
-            b = d;
-            d = c;
-            fd = fc;
-            c = b - g * (b - a);
-            fc = f(c);
-        } else {
-            a = c;
-            c = d;
-            fc = fd;
-            d = a + g * (b - a);
-            fd = f(d);
-        }
-    }
-    let (t, ft) = if fc < fd { (c, fc) } else { (d, fd) };
-    if ft < sc[j].1 { (t, ft) } else { sc[j] }
 }

@@ -9,6 +9,7 @@ use super::plot::{PlotError, register_font};
 use super::sig;
 use crate::gap::benchmark::{BenchmarkSummary, CaseRow};
 use crate::gap::diagnose::{AnswerKind, Diagnosis};
+use crate::gap::explore::{Exploration, PLAUSIBLE_P};
 use crate::gap::knob::KnobKind;
 use crate::gap::library::EffectSummary;
 use crate::gap::trials::Metric;
@@ -480,6 +481,103 @@ fn draw_residuals<DB: DrawingBackend>(
 
 /// The benchmark as Markdown: scores against targets, thresholds, confusion matrices, and
 /// the cases outside the library one by one.
+/// An exploration of the uncertain parameters as markdown.
+pub fn exploration_md(e: &Exploration) -> String {
+    let mut o = String::new();
+    let _ = writeln!(
+        o,
+        "# Exploration of the uncertain parameters: {}\n",
+        e.origin
+    );
+    let _ = writeln!(
+        o,
+        "{} settings (Latin hypercube over every declared [[uncertain]] range, seed {}), {} \
+         measurements, {} walks. Plausible: χ² p ≥ {PLAUSIBLE_P} ({} df).\n",
+        e.samples, e.seed, e.observations, e.walks, e.observations
+    );
+    let verdict = if e.plausible > 0 {
+        format!(
+            "**{} of {} settings fit the trials within noise** (nominal χ² = {}, best χ² = {}, p = {:.2}).",
+            e.plausible,
+            e.samples,
+            sig(e.nominal_chi2),
+            sig(e.best_chi2),
+            e.best_p
+        )
+    } else {
+        format!(
+            "**No setting in the declared ranges fits the trials within noise** (nominal χ² = {}, \
+             best of {} χ² = {}, p = {:.1e}): either a parameter lies outside its declared range, \
+             a parameter not declared uncertain is off, or the model lacks an effect.",
+            sig(e.nominal_chi2),
+            e.samples,
+            sig(e.best_chi2),
+            e.best_p
+        )
+    };
+    let _ = writeln!(o, "{verdict}\n");
+    let _ = writeln!(o, "## What each measurement can reach\n");
+    let _ = writeln!(
+        o,
+        "| trial | metric | measured | sd | nominal | lowest – highest over the sample | best setting | reachable |"
+    );
+    let _ = writeln!(o, "|---|---|---:|---:|---:|---|---:|---|");
+    for m in &e.metrics {
+        let _ = writeln!(
+            o,
+            "| {} | {} | {} | {} | {} | {} – {} | {} | {} |",
+            m.trial,
+            m.metric.column(),
+            sig(m.measured),
+            sig(m.sd),
+            sig(m.nominal),
+            sig(m.reach[0]),
+            sig(m.reach[1]),
+            sig(m.best),
+            if m.reachable { "yes" } else { "**no**" }
+        );
+    }
+    let _ = writeln!(o, "\n## The parameters\n");
+    let _ = writeln!(
+        o,
+        "Plausible: lowest – highest value among the plausible settings; width: its share of the \
+         declared range (near 1: these trials do not pin the parameter down). ρ: Spearman rank \
+         correlation of the value with χ² over the walking settings (negative: higher values fit \
+         better).\n"
+    );
+    let _ = writeln!(
+        o,
+        "| parameter | nominal | range | best setting | plausible | width | ρ with χ² | why uncertain |"
+    );
+    let _ = writeln!(o, "|---|---:|---|---:|---|---:|---:|---|");
+    for p in &e.parameters {
+        let (plaus, width) = match (p.plausible, p.plausible_width) {
+            (Some([a, b]), Some(w)) => (format!("{} – {}", sig(a), sig(b)), format!("{w:.2}")),
+            _ => ("–".to_string(), "–".to_string()),
+        };
+        let _ = writeln!(
+            o,
+            "| {} | {} | {} – {} | {} | {} | {} | {:+.2} | {} |",
+            p.parameter,
+            sig(p.nominal),
+            sig(p.range[0]),
+            sig(p.range[1]),
+            sig(p.best),
+            plaus,
+            width,
+            p.rank_correlation_with_chi2,
+            p.why.replace('|', "/")
+        );
+    }
+    if !e.notes.is_empty() {
+        let _ = writeln!(o, "\nNotes:");
+        for n in &e.notes {
+            let _ = writeln!(o, "- {n}");
+        }
+    }
+    o
+}
+
 pub fn benchmark_md(b: &BenchmarkSummary, rows: &[CaseRow], command: &str) -> String {
     let mut o = String::new();
     let _ = writeln!(

@@ -15,7 +15,7 @@ use robot_survey::gap::synth::{add_noise, truth_metrics};
 use robot_survey::gap::trials::{Metric, TrialSet};
 use robot_survey::sim::Design;
 
-use super::common::{repo, stderr, survey};
+use super::common::{repo, stderr, stdout, survey};
 
 const TEST_DESIGN: &str = "mugatu-two-uncertain";
 
@@ -432,4 +432,66 @@ fn benchmark_scores_count_what_the_rows_say() {
     assert_eq!((wrong_param.k, wrong_param.n), (1, 2));
     let cov = get("95 % intervals holding the truth");
     assert_eq!((cov.k, cov.n), (1, 1));
+}
+
+/// `survey gap explore`: a walking speed above the Froude limit of walking, v ≤ √(g·L)
+/// (the inverted-pendulum bound, 0.49 m/s for Zippy's 24.7 mm legs), is out of reach of every
+/// plausible setting; nothing is plausible; the same seed gives the same bytes.
+#[test]
+fn explore_finds_no_setting_beyond_the_froude_limit() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let trials = dir.path().join("fast.csv");
+    std::fs::write(
+        &trials,
+        "label,design,leg_length_m,velocity_mps,velocity_mps_sd,source\n\
+         too-fast,zippy,0.0247,1.0,0.05,hand-made: twice the Froude limit\n",
+    )
+    .expect("write");
+    let args = [
+        "gap",
+        "explore",
+        "--trials",
+        trials.to_str().expect("utf-8"),
+        "--samples",
+        "24",
+        "--seed",
+        "4",
+        "--format",
+        "json",
+    ];
+    let o = survey(&args);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let e: serde_json::Value = serde_json::from_str(&stdout(&o)).expect("json");
+    assert_eq!(e["plausible"], 0);
+    let m = &e["metrics"][0];
+    assert_eq!(m["reachable"], false);
+    let froude_limit = (9.81f64 * 0.0247).sqrt();
+    let top = m["reach"][1].as_f64().expect("reach");
+    assert!(top < froude_limit, "a walk at {top} m/s beats √(gL)");
+    assert_eq!(
+        e["parameters"].as_array().map(Vec::len),
+        Some(8),
+        "zippy declares 8"
+    );
+    let again = survey(&args);
+    assert_eq!(stdout(&o), stdout(&again), "deterministic in the seed");
+}
+
+#[test]
+fn explore_rejects_designs_without_uncertain_parameters_and_tiny_samples() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let trials = dir.path().join("t.csv");
+    std::fs::write(
+        &trials,
+        "label,design,leg_length_m,velocity_mps,source\n\
+         a,zippy-ref,0.0247,0.1,hand-made\n",
+    )
+    .expect("write");
+    let t = trials.to_str().expect("utf-8");
+    let o = survey(&["gap", "explore", "--trials", t]);
+    assert_ne!(o.status.code(), Some(0));
+    assert!(stderr(&o).contains("[[uncertain]]"), "{}", stderr(&o));
+    let o = survey(&["gap", "explore", "--trials", t, "--samples", "1"]);
+    assert_ne!(o.status.code(), Some(0));
+    assert!(stderr(&o).contains("at least 2 samples"), "{}", stderr(&o));
 }

@@ -1,0 +1,356 @@
+//! Which settings of a design's declared uncertain parameters are compatible with the trials
+//! at all: a space-filling exploration of their whole box ("history matching").
+//!
+//! The diagnosis calibrates by fitting from the nominal point on an additive surrogate, a
+//! local answer. When the question is global — can *any* plausible setting reproduce the
+//! hardware? which parameters does that pin down? — the honest tool is to walk a
+//! space-filling sample of the box and keep the settings whose χ² against the trials is
+//! within noise (χ² p-value ≥ [`PLAUSIBLE_P`]): every parameter's range among them says how
+//! far the trials identify it, and the reach of each measured metric over the sample says
+//! whether the box can get there at all. The sample is a Latin hypercube in the parameters'
+//! own coordinates (log where the design declares `log = true`), deterministic in its seed.
+
+use rand::{Rng, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+use serde::Serialize;
+
+use super::cache::SimCache;
+use super::diagnose::{fill_from_trajectories, observations};
+use super::error::GapError;
+use super::knob::{KnobKind, Knobs};
+use super::library::EffectLibrary;
+use super::problem::{Observation, chi2_of};
+use super::simulate::Condition;
+use super::trials::{Metric, TrialSet};
+use crate::regression::dist::chi2_upper_p;
+
+/// A setting is plausible when its χ² against the trials has at least this p-value.
+pub const PLAUSIBLE_P: f64 = 0.05;
+
+#[derive(Clone, Debug)]
+pub struct ExploreOptions {
+    /// Settings walked (each on every condition).
+    pub samples: usize,
+    pub seed: u64,
+    /// Relative sd assumed where a measurement states none.
+    pub default_relative_sd: f64,
+}
+
+impl Default for ExploreOptions {
+    fn default() -> Self {
+        ExploreOptions {
+            samples: 256,
+            seed: 1,
+            default_relative_sd: 0.1,
+        }
+    }
+}
+
+/// One parameter over the sample.
+#[derive(Clone, Debug, Serialize)]
+pub struct ParameterReach {
+    /// `design:path`.
+    pub parameter: String,
+    pub nominal: f64,
+    pub range: [f64; 2],
+    /// Its value in the best setting.
+    pub best: f64,
+    /// Lowest and highest value among the plausible settings (None: no plausible setting).
+    pub plausible: Option<[f64; 2]>,
+    /// Share of the range (in its own coordinate) the plausible values span: near 1, the
+    /// trials do not pin it down; small, they do (within the sample's resolution).
+    pub plausible_width: Option<f64>,
+    /// Spearman rank correlation between the value and the χ² over the walking settings:
+    /// which way the trials push it.
+    pub rank_correlation_with_chi2: f64,
+    pub why: String,
+}
+
+/// One measured metric over the sample.
+#[derive(Clone, Debug, Serialize)]
+pub struct MetricReach {
+    pub trial: String,
+    pub metric: Metric,
+    pub measured: f64,
+    pub sd: f64,
+    pub nominal: f64,
+    /// Lowest and highest simulated value over the walking settings.
+    pub reach: [f64; 2],
+    /// Value in the best setting.
+    pub best: f64,
+    /// The measured value lies within the reach widened by 2 sd.
+    pub reachable: bool,
+}
+
+#[derive(Clone, Debug, Serialize)]
+pub struct Exploration {
+    pub origin: String,
+    pub samples: usize,
+    pub seed: u64,
+    pub observations: usize,
+    /// Settings with a walk that fell on some condition.
+    pub fell: usize,
+    pub plausible: usize,
+    pub nominal_chi2: f64,
+    pub best_chi2: f64,
+    pub best_p: f64,
+    pub parameters: Vec<ParameterReach>,
+    pub metrics: Vec<MetricReach>,
+    pub walks: usize,
+    pub notes: Vec<String>,
+}
+
+/// A Latin hypercube of `n` points in [0, 1]^dim: each coordinate's n strata each hold one
+/// point, jittered within the stratum, strata shuffled per coordinate (Fisher–Yates).
+pub fn latin_hypercube(n: usize, dim: usize, seed: u64) -> Vec<Vec<f64>> {
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    let mut columns: Vec<Vec<f64>> = Vec::with_capacity(dim);
+    for _ in 0..dim {
+        let mut strata: Vec<usize> = (0..n).collect();
+        for i in (1..n).rev() {
+            let j = rng.random_range(0..=i);
+            strata.swap(i, j);
+        }
+        columns.push(
+            strata
+                .into_iter()
+                .map(|s| (s as f64 + rng.random::<f64>()) / n as f64)
+                .collect(),
+        );
+    }
+    (0..n)
+        .map(|i| columns.iter().map(|c| c[i]).collect())
+        .collect()
+}
+
+/// Ranks (average ranks for ties), for the Spearman correlation.
+fn ranks(v: &[f64]) -> Vec<f64> {
+    let mut idx: Vec<usize> = (0..v.len()).collect();
+    idx.sort_by(|a, b| v[*a].total_cmp(&v[*b]));
+    let mut r = vec![0.0; v.len()];
+    let mut i = 0;
+    while i < idx.len() {
+        let mut j = i;
+        while j + 1 < idx.len() && v[idx[j + 1]] == v[idx[i]] {
+            j += 1;
+        }
+        let avg = (i + j) as f64 / 2.0;
+        for k in &idx[i..=j] {
+            r[*k] = avg;
+        }
+        i = j + 1;
+    }
+    r
+}
+
+/// Spearman's rank correlation (NaN when either side is constant).
+pub fn spearman(x: &[f64], y: &[f64]) -> f64 {
+    let (rx, ry) = (ranks(x), ranks(y));
+    let n = rx.len() as f64;
+    let (mx, my) = (rx.iter().sum::<f64>() / n, ry.iter().sum::<f64>() / n);
+    let (mut sxy, mut sxx, mut syy) = (0.0, 0.0, 0.0);
+    for (a, b) in rx.iter().zip(&ry) {
+        sxy += (a - mx) * (b - my);
+        sxx += (a - mx) * (a - mx);
+        syy += (b - my) * (b - my);
+    }
+    sxy / (sxx * syy).sqrt()
+}
+
+/// Walks a Latin hypercube over every declared uncertain parameter of the trials' designs
+/// and reports which settings fit the trials within noise.
+pub fn explore(
+    set: &TrialSet,
+    conditions: &[Condition],
+    lib: &EffectLibrary,
+    opts: &ExploreOptions,
+    cache: &SimCache,
+    progress: &(dyn Fn() + Sync),
+) -> Result<Exploration, GapError> {
+    if opts.samples < 2 {
+        return Err(GapError::Invalid("explore needs at least 2 samples".into()));
+    }
+    if !(opts.default_relative_sd > 0.0 && opts.default_relative_sd.is_finite()) {
+        return Err(GapError::Invalid(
+            "the default relative sd must be finite and > 0".into(),
+        ));
+    }
+    let filled = fill_from_trajectories(set, conditions, lib)?;
+    let set = &filled;
+    let (obs, mut notes) = observations(set, opts.default_relative_sd);
+    if obs.is_empty() {
+        return Err(GapError::File {
+            path: set.origin.clone(),
+            message: "no trial has a measured metric the simulator computes (velocity_mps, \
+                      step_frequency_hz, roll/pitch/yaw_pp_deg, peak_torque_nm, cot)"
+                .into(),
+        });
+    }
+    let mut designs: Vec<&crate::sim::Design> = Vec::new();
+    for c in conditions {
+        if !designs.iter().any(|d| d.name == c.design.name) {
+            designs.push(&c.design);
+        }
+    }
+    let knobs = Knobs::build(&designs, &[], true).map_err(|e| GapError::Sim {
+        origin: set.origin.clone(),
+        source: e,
+    })?;
+    let params: Vec<usize> = (0..knobs.len())
+        .filter(|i| knobs.list[*i].kind == KnobKind::Parameter)
+        .collect();
+    if params.is_empty() {
+        return Err(GapError::Invalid(format!(
+            "{}: no design of these trials declares [[uncertain]] parameters: nothing to explore",
+            set.origin
+        )));
+    }
+    let units = latin_hypercube(opts.samples, params.len(), opts.seed);
+    let points: Vec<Vec<Option<f64>>> = units
+        .iter()
+        .map(|u| {
+            let mut p = knobs.nominal_point();
+            for (s, i) in u.iter().zip(&params) {
+                p[*i] = Some(knobs.list[*i].from_unit(*s));
+            }
+            p
+        })
+        .collect();
+    let mut settings = vec![knobs.setting(lib, &knobs.nominal_point())];
+    settings.extend(points.iter().map(|p| knobs.setting(lib, p)));
+    let walks_before = cache.walks();
+    let sims = cache.get_many(conditions, lib, &settings, progress)?;
+    let nominal_chi2 = chi2_of(&obs, &sims[0]).0;
+    let n_obs = obs.len();
+
+    let sample_sims = &sims[1..];
+    let fell: Vec<bool> = sample_sims
+        .iter()
+        .map(|s| s.iter().any(|m| m.fell))
+        .collect();
+    let chi2: Vec<f64> = sample_sims.iter().map(|s| chi2_of(&obs, s).0).collect();
+    let plausible: Vec<bool> = chi2
+        .iter()
+        .zip(&fell)
+        .map(|(c, f)| !f && chi2_upper_p(*c, n_obs as f64).unwrap_or(0.0) >= PLAUSIBLE_P)
+        .collect();
+    let best = (0..chi2.len())
+        .min_by(|a, b| chi2[*a].total_cmp(&chi2[*b]))
+        .ok_or_else(|| GapError::Invalid("no sample".into()))?;
+    let walking: Vec<usize> = (0..chi2.len()).filter(|i| !fell[*i]).collect();
+    if walking.len() < opts.samples {
+        notes.push(format!(
+            "{} of {} settings fell on some condition (χ² charged as a fall)",
+            opts.samples - walking.len(),
+            opts.samples
+        ));
+    }
+
+    let parameters = params
+        .iter()
+        .enumerate()
+        .map(|(j, i)| {
+            let k = &knobs.list[*i];
+            let coord = |p: &Vec<Option<f64>>| p[*i].unwrap_or(f64::NAN);
+            let plaus: Vec<f64> = points
+                .iter()
+                .zip(&plausible)
+                .filter(|(_, ok)| **ok)
+                .map(|(p, _)| coord(p))
+                .collect();
+            let (plausible_range, width) = if plaus.is_empty() {
+                (None, None)
+            } else {
+                let lo = plaus.iter().copied().fold(f64::INFINITY, f64::min);
+                let hi = plaus.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+                (
+                    Some([k.value(lo), k.value(hi)]),
+                    Some((hi - lo) / (k.hi - k.lo)),
+                )
+            };
+            let xs: Vec<f64> = walking.iter().map(|w| units[*w][j]).collect();
+            let ys: Vec<f64> = walking.iter().map(|w| chi2[*w]).collect();
+            ParameterReach {
+                parameter: k.label(),
+                nominal: k.nominal.map(|x| k.value(x)).unwrap_or(f64::NAN),
+                range: [k.value(k.lo), k.value(k.hi)],
+                best: k.value(coord(&points[best])),
+                plausible: plausible_range,
+                plausible_width: width,
+                rank_correlation_with_chi2: if xs.len() > 2 {
+                    spearman(&xs, &ys)
+                } else {
+                    f64::NAN
+                },
+                why: k.why.clone(),
+            }
+        })
+        .collect();
+
+    let metrics = obs
+        .iter()
+        .map(|o: &Observation| {
+            let vals: Vec<f64> = walking
+                .iter()
+                .map(|w| sample_sims[*w][o.trial].get(o.metric))
+                .filter(|v| v.is_finite())
+                .collect();
+            let lo = vals.iter().copied().fold(f64::INFINITY, f64::min);
+            let hi = vals.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+            MetricReach {
+                trial: set.trials[o.trial].label.clone(),
+                metric: o.metric,
+                measured: o.value,
+                sd: o.sd,
+                nominal: sims[0][o.trial].get(o.metric),
+                reach: [lo, hi],
+                best: sample_sims[best][o.trial].get(o.metric),
+                reachable: lo - 2.0 * o.sd <= o.value && o.value <= hi + 2.0 * o.sd,
+            }
+        })
+        .collect();
+
+    Ok(Exploration {
+        origin: set.origin.clone(),
+        samples: opts.samples,
+        seed: opts.seed,
+        observations: n_obs,
+        fell: opts.samples - walking.len(),
+        plausible: plausible.iter().filter(|p| **p).count(),
+        nominal_chi2,
+        best_chi2: chi2[best],
+        best_p: chi2_upper_p(chi2[best], n_obs as f64).unwrap_or(0.0),
+        parameters,
+        metrics,
+        walks: cache.walks() - walks_before,
+        notes,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn latin_hypercube_fills_every_stratum_once() {
+        let n = 17;
+        let pts = latin_hypercube(n, 3, 9);
+        assert_eq!(pts.len(), n);
+        for d in 0..3 {
+            let mut strata: Vec<usize> = pts.iter().map(|p| (p[d] * n as f64) as usize).collect();
+            strata.sort();
+            assert_eq!(strata, (0..n).collect::<Vec<_>>(), "coordinate {d}");
+        }
+        assert_eq!(pts, latin_hypercube(n, 3, 9), "deterministic in the seed");
+    }
+
+    #[test]
+    fn spearman_matches_hand_values() {
+        // Monotone: +1 / −1 whatever the spacing.
+        assert!((spearman(&[1.0, 2.0, 3.0, 4.0], &[1.0, 10.0, 100.0, 1000.0]) - 1.0).abs() < 1e-12);
+        assert!((spearman(&[1.0, 2.0, 3.0, 4.0], &[4.0, 3.0, 1.0, 0.5]) + 1.0).abs() < 1e-12);
+        // Ranks x = 1..5, y = (2,1,4,3,5): Σd² = 4, ρ = 1 − 6·4/(5·24) = 0.8.
+        let r = spearman(&[1.0, 2.0, 3.0, 4.0, 5.0], &[2.0, 1.0, 4.0, 3.0, 5.0]);
+        assert!((r - 0.8).abs() < 1e-12, "{r}");
+    }
+}
