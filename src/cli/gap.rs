@@ -427,6 +427,19 @@ fn benchmark(a: &BenchmarkArgs) -> anyhow::Result<ExitCode> {
     if a.quick {
         command.push_str(" --quick");
     }
+    if let Some(n) = &a.noise {
+        let n: Vec<String> = n.iter().map(|x| x.to_string()).collect();
+        command.push_str(&format!(" --noise {}", n.join(",")));
+    }
+    if let Some(n) = a.null_cases {
+        command.push_str(&format!(" --null-cases {n}"));
+    }
+    if let Some(s) = a.seeds {
+        command.push_str(&format!(" --seeds {s}"));
+    }
+    if !a.effects.is_empty() {
+        command.push_str(&format!(" --effects {}", a.effects.join(",")));
+    }
     if let Some(d) = &a.drake {
         command.push_str(&format!(" --drake {}", d.display()));
     }

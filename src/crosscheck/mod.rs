@@ -137,6 +137,10 @@ pub fn case_design(root: &Path, case: &Case) -> Result<Design, CrosscheckError> 
         message: e.to_string(),
     })?;
     apply_overrides(&mut table, &case.overrides);
+    // A case turns the walker into an elementary body (a sphere on an incline, a sliding
+    // box): the design's [[uncertain]] ranges describe the walker, not these bodies, and
+    // an override outside them is the case, not an error.
+    table.remove("uncertain");
     let text = toml::to_string(&table).map_err(|e| CrosscheckError::Invalid {
         path: path.clone(),
         message: e.to_string(),

@@ -744,6 +744,10 @@ pub fn plan(
             suites.push(Suite::new("drake", base)?);
         }
     }
+    // Two multiples of a threshold clamped to the same end of an effect's range make the
+    // same truth: one case (the key is the truth), not two rows that collide.
+    let mut seen = std::collections::HashSet::new();
+    cases.retain(|c| seen.insert(c.key.clone()));
     Ok(Plan {
         cases,
         thresholds: thr_table,

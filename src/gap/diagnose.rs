@@ -846,6 +846,9 @@ fn answer(
     let kind = match (leads.is_empty(), parameters.is_empty(), effects.is_empty()) {
         _ if steps.is_empty() && nominal_within_noise => AnswerKind::WithinNoise,
         (false, _, _) => AnswerKind::PartlyExplained,
+        // Look-alikes that together leave the rest beyond noise: not "ambiguous" (that
+        // answer says the gap is explained), only partly explained.
+        (true, true, true) if !ambiguous.is_empty() && !fits => AnswerKind::PartlyExplained,
         (true, true, true) if !ambiguous.is_empty() => AnswerKind::Ambiguous,
         (true, true, true) if nominal_within_noise => AnswerKind::WithinNoise,
         (true, true, true) => AnswerKind::Unexplained,
@@ -1018,7 +1021,11 @@ fn statement(
              in {}; leads, not findings: {}",
             chain.join(", "),
             rest.unwrap_or("several metrics"),
-            list(leads)
+            if leads.is_empty() {
+                "only the groups below".to_string()
+            } else {
+                list(leads)
+            }
         ),
         AnswerKind::Ambiguous => format!(
             "ambiguous: the gap is explained (chain {}){}, but no knob is named",
