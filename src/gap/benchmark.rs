@@ -700,24 +700,19 @@ pub fn plan(
                 .strip_prefix("trials-")
                 .and_then(|rest| rest.rsplit_once('-'))
                 .and_then(|(e, v)| Some((e.to_string(), v.parse::<f64>().ok()?)));
-            let conditions = resolve(&set)?;
-            let truth: Vec<SimMetrics> = set
-                .trials
-                .iter()
-                .map(|t| {
-                    let mut values = [f64::NAN; 8];
-                    for m in Metric::SIMULATED {
-                        if let Some(v) = t.measured(m) {
-                            values[m.index()] = v.value;
-                        }
-                    }
-                    SimMetrics {
-                        values,
-                        fell: values.iter().all(|v| v.is_nan()),
-                    }
-                })
-                .collect();
-            let _ = conditions;
+            // One suite serves every Drake file: its conditions must be the first file's.
+            if let Some((first, _)) = drake.values().next()
+                && !same_conditions(first, &set)
+            {
+                return Err(GapError::File {
+                    path: f.display().to_string(),
+                    message: format!(
+                        "its conditions differ from those of the other Drake trials files in {}",
+                        dir.display()
+                    ),
+                });
+            }
+            let truth: Vec<SimMetrics> = set.trials.iter().map(SimMetrics::measured_by).collect();
             for seed in 0..opts.drake_seeds {
                 let key = format!("drake/{name}/n{}/s{seed}", opts.pair_noise);
                 cases.push(CaseSpec {
@@ -764,6 +759,24 @@ pub fn spec(opts: &BenchmarkOptions) -> String {
     )
 }
 
+/// Two trials files hold the same conditions (design, size and every condition column,
+/// in order), whatever they measured.
+fn same_conditions(a: &TrialSet, b: &TrialSet) -> bool {
+    a.trials.len() == b.trials.len()
+        && a.trials.iter().zip(&b.trials).all(|(x, y)| {
+            x.design == y.design
+                && x.leg_length_m == y.leg_length_m
+                && x.mass_kg == y.mass_kg
+                && x.mass_law == y.mass_law
+                && x.contact == y.contact
+                && x.frequency_hz == y.frequency_hz
+                && x.amplitude_deg == y.amplitude_deg
+                && x.torque_limit_nm == y.torque_limit_nm
+                && x.torque_nm == y.torque_nm
+                && x.slope_deg == y.slope_deg
+        })
+}
+
 /// Runs one case.
 fn run_case(
     case: &CaseSpec,
@@ -776,28 +789,20 @@ fn run_case(
         .iter()
         .find(|s| s.name == case.suite)
         .ok_or_else(|| GapError::Invalid(format!("no suite {}", case.suite)))?;
-    let (truth, truth_effects, truth_params, declared) = match &case.truth {
+    let truth = match &case.truth {
         Truth::Sim { params, effects } => {
             let setting = truth_setting(lib, design, params, effects)?;
-            let t = if setting == ModelSetting::nominal() {
+            if setting == ModelSetting::nominal() {
                 suite.cache.get(&suite.conditions, lib, &setting, &|| {})?
             } else {
                 truth_metrics(&suite.conditions, lib, &setting, &|| {})?
-            };
-            let declared = !params.is_empty()
-                && params
-                    .iter()
-                    .all(|(p, _)| design.uncertain.iter().any(|u| &u.path == p));
-            (t, pairs(effects), pairs(params), declared)
+            }
         }
-        Truth::Drake { file, effect } => {
-            let (_, t) = plan
-                .drake
-                .get(file)
-                .ok_or_else(|| GapError::Invalid(format!("no Drake trials {file}")))?;
-            let e = effect.iter().cloned().collect::<Vec<_>>();
-            (t.clone(), pairs(&e), String::new(), false)
-        }
+        Truth::Drake { file, .. } => plan
+            .drake
+            .get(file)
+            .map(|(_, t)| t.clone())
+            .ok_or_else(|| GapError::Invalid(format!("no Drake trials {file}")))?,
     };
     let trials = add_noise(
         &suite.base.trials,
@@ -820,37 +825,25 @@ fn run_case(
     };
     let walks0 = suite.cache.walks();
     let (d, _) = diagnose_conditions(&set, &suite.conditions, lib, &opts, &suite.cache, &|_| {})?;
-    let named_effects: Vec<String> = d.answer.effects.iter().map(|n| n.knob.clone()).collect();
-    let named_params: Vec<String> = d.answer.parameters.iter().map(|n| n.knob.clone()).collect();
-    let intervals: Vec<String> = d
-        .answer
-        .effects
-        .iter()
-        .chain(&d.answer.parameters)
-        .map(|n| format!("{}={}..{}", n.knob, n.interval[0], n.interval[1]))
-        .collect();
-    Ok(CaseRow {
-        key: case.key.clone(),
-        suite: case.suite.clone(),
-        kind: case.kind.clone(),
-        noise: case.noise,
-        seed: case.seed,
-        calibrate: case.calibrate,
-        multiple: case.multiple,
-        truth_effects,
-        truth_params,
-        truth_declared: declared,
-        answer: format!("{:?}", d.answer.kind),
-        named_effects: named_effects.join(";"),
-        named_params: named_params.join(";"),
-        intervals: intervals.join(";"),
-        leads: d
-            .answer
-            .leads
-            .iter()
+    let knobs = |v: &[super::diagnose::Named]| {
+        v.iter()
             .map(|n| n.knob.clone())
             .collect::<Vec<_>>()
+            .join(";")
+    };
+    Ok(CaseRow {
+        answer: format!("{:?}", d.answer.kind),
+        named_effects: knobs(&d.answer.effects),
+        named_params: knobs(&d.answer.parameters),
+        intervals: d
+            .answer
+            .effects
+            .iter()
+            .chain(&d.answer.parameters)
+            .map(|n| format!("{}={}..{}", n.knob, n.interval[0], n.interval[1]))
+            .collect::<Vec<_>>()
             .join(";"),
+        leads: knobs(&d.answer.leads),
         ambiguous: d
             .answer
             .ambiguous
@@ -861,37 +854,49 @@ fn run_case(
         gap_before: d.gap_before,
         gap_after: d.chain.last().map(|s| s.gap_after),
         walks: suite.cache.walks() - walks0,
+        ..CaseRow::unanswered(case, design)
     })
 }
 
-fn error_row(case: &CaseSpec, message: &str) -> CaseRow {
-    let (truth_effects, truth_params) = match &case.truth {
-        Truth::Sim { params, effects } => (pairs(effects), pairs(params)),
-        Truth::Drake { effect, .. } => (
-            pairs(&effect.iter().cloned().collect::<Vec<_>>()),
-            String::new(),
-        ),
-    };
-    CaseRow {
-        key: case.key.clone(),
-        suite: case.suite.clone(),
-        kind: case.kind.clone(),
-        noise: case.noise,
-        seed: case.seed,
-        calibrate: case.calibrate,
-        multiple: case.multiple,
-        truth_effects,
-        truth_params,
-        truth_declared: false,
-        answer: format!("NotDiagnosed: {message}"),
-        named_effects: String::new(),
-        named_params: String::new(),
-        intervals: String::new(),
-        ambiguous: String::new(),
-        leads: String::new(),
-        gap_before: f64::NAN,
-        gap_after: None,
-        walks: 0,
+impl CaseRow {
+    /// The row of a case before its answer: what made its trials, nothing named.
+    fn unanswered(case: &CaseSpec, design: &Design) -> CaseRow {
+        let (truth_effects, truth_params, truth_declared) = match &case.truth {
+            Truth::Sim { params, effects } => (
+                pairs(effects),
+                pairs(params),
+                !params.is_empty()
+                    && params
+                        .iter()
+                        .all(|(p, _)| design.uncertain.iter().any(|u| &u.path == p)),
+            ),
+            Truth::Drake { effect, .. } => (
+                pairs(&effect.iter().cloned().collect::<Vec<_>>()),
+                String::new(),
+                false,
+            ),
+        };
+        CaseRow {
+            key: case.key.clone(),
+            suite: case.suite.clone(),
+            kind: case.kind.clone(),
+            noise: case.noise,
+            seed: case.seed,
+            calibrate: case.calibrate,
+            multiple: case.multiple,
+            truth_effects,
+            truth_params,
+            truth_declared,
+            answer: String::new(),
+            named_effects: String::new(),
+            named_params: String::new(),
+            intervals: String::new(),
+            ambiguous: String::new(),
+            leads: String::new(),
+            gap_before: f64::NAN,
+            gap_after: None,
+            walks: 0,
+        }
     }
 }
 
@@ -927,7 +932,10 @@ pub fn run(
             // nothing was measured) is a row saying so, not the end of the benchmark.
             let row = match run_case(c, plan, lib, &design) {
                 Ok(r) => r,
-                Err(GapError::File { message, .. }) => error_row(c, &message),
+                Err(GapError::File { message, .. }) => CaseRow {
+                    answer: format!("NotDiagnosed: {message}"),
+                    ..CaseRow::unanswered(c, &design)
+                },
                 Err(e) => return Err(e),
             };
             append_to(log.as_ref(), &row)?;

@@ -209,7 +209,7 @@ pub struct Timing {
 
 /// Trials whose `trajectory` file is given get the metrics they lack measured from it, by
 /// the code that measures the simulator's walks (`sim::report_from_trajectory`).
-pub fn fill_from_trajectories(
+fn fill_from_trajectories(
     set: &TrialSet,
     conditions: &[Condition],
     lib: &EffectLibrary,
@@ -274,6 +274,44 @@ pub fn observations(set: &TrialSet, default_relative_sd: f64) -> (Vec<Observatio
     (obs, notes)
 }
 
+/// The trials with the metrics their trajectories give filled in, their observations and
+/// notes; an error when the default sd is not a positive number or nothing measured is
+/// something the simulator computes.
+pub fn measured(
+    set: &TrialSet,
+    conditions: &[Condition],
+    lib: &EffectLibrary,
+    default_relative_sd: f64,
+) -> Result<(TrialSet, Vec<Observation>, Vec<String>), GapError> {
+    if !(default_relative_sd > 0.0 && default_relative_sd.is_finite()) {
+        return Err(GapError::Invalid(
+            "the default relative sd must be finite and > 0".into(),
+        ));
+    }
+    let filled = fill_from_trajectories(set, conditions, lib)?;
+    let (obs, notes) = observations(&filled, default_relative_sd);
+    if obs.is_empty() {
+        return Err(GapError::File {
+            path: filled.origin.clone(),
+            message: "no trial has a measured metric the simulator computes (velocity_mps, \
+                      step_frequency_hz, roll/pitch/yaw_pp_deg, peak_torque_nm, cot)"
+                .into(),
+        });
+    }
+    Ok((filled, obs, notes))
+}
+
+/// The distinct designs of the conditions, in order of first appearance.
+pub fn designs_of(conditions: &[Condition]) -> Vec<&crate::sim::Design> {
+    let mut designs: Vec<&crate::sim::Design> = Vec::new();
+    for c in conditions {
+        if !designs.iter().any(|d| d.name == c.design.name) {
+            designs.push(&c.design);
+        }
+    }
+    designs
+}
+
 /// Diagnoses `set` against the simulator.
 pub fn diagnose(
     set: &TrialSet,
@@ -287,11 +325,6 @@ pub fn diagnose(
 }
 
 fn check_options(opts: &DiagnoseOptions) -> Result<(), GapError> {
-    if !(opts.default_relative_sd > 0.0 && opts.default_relative_sd.is_finite()) {
-        return Err(GapError::Invalid(
-            "the default relative sd must be finite and > 0".into(),
-        ));
-    }
     if !(opts.alpha > 0.0 && opts.alpha < 1.0) {
         return Err(GapError::Invalid("alpha must be in (0, 1)".into()));
     }
@@ -421,23 +454,9 @@ pub fn diagnose_conditions(
 ) -> Result<(Diagnosis, Timing), GapError> {
     check_options(opts)?;
     let candidates = lib.subset(&opts.effects)?;
-    let filled = fill_from_trajectories(set, conditions, lib)?;
+    let (filled, obs, mut notes) = measured(set, conditions, lib, opts.default_relative_sd)?;
     let set = &filled;
-    let (obs, mut notes) = observations(set, opts.default_relative_sd);
-    if obs.is_empty() {
-        return Err(GapError::File {
-            path: set.origin.clone(),
-            message: "no trial has a measured metric the simulator computes (velocity_mps, \
-                      step_frequency_hz, roll/pitch/yaw_pp_deg, peak_torque_nm, cot)"
-                .into(),
-        });
-    }
-    let mut designs: Vec<&crate::sim::Design> = Vec::new();
-    for c in conditions {
-        if !designs.iter().any(|d| d.name == c.design.name) {
-            designs.push(&c.design);
-        }
-    }
+    let designs = designs_of(conditions);
     let knobs = Knobs::build(&designs, &candidates, opts.calibrate).map_err(|e| GapError::Sim {
         origin: set.origin.clone(),
         source: e,

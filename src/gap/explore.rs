@@ -15,7 +15,7 @@ use rand_chacha::ChaCha8Rng;
 use serde::Serialize;
 
 use super::cache::SimCache;
-use super::diagnose::{fill_from_trajectories, observations};
+use super::diagnose::{designs_of, measured};
 use super::error::GapError;
 use super::knob::{KnobKind, Knobs};
 use super::library::EffectLibrary;
@@ -170,28 +170,9 @@ pub fn explore(
     if opts.samples < 2 {
         return Err(GapError::Invalid("explore needs at least 2 samples".into()));
     }
-    if !(opts.default_relative_sd > 0.0 && opts.default_relative_sd.is_finite()) {
-        return Err(GapError::Invalid(
-            "the default relative sd must be finite and > 0".into(),
-        ));
-    }
-    let filled = fill_from_trajectories(set, conditions, lib)?;
+    let (filled, obs, mut notes) = measured(set, conditions, lib, opts.default_relative_sd)?;
     let set = &filled;
-    let (obs, mut notes) = observations(set, opts.default_relative_sd);
-    if obs.is_empty() {
-        return Err(GapError::File {
-            path: set.origin.clone(),
-            message: "no trial has a measured metric the simulator computes (velocity_mps, \
-                      step_frequency_hz, roll/pitch/yaw_pp_deg, peak_torque_nm, cot)"
-                .into(),
-        });
-    }
-    let mut designs: Vec<&crate::sim::Design> = Vec::new();
-    for c in conditions {
-        if !designs.iter().any(|d| d.name == c.design.name) {
-            designs.push(&c.design);
-        }
-    }
+    let designs = designs_of(conditions);
     let knobs = Knobs::build(&designs, &[], true).map_err(|e| GapError::Sim {
         origin: set.origin.clone(),
         source: e,

@@ -167,6 +167,31 @@ impl<'a> FitContext<'a> {
             .get(self.conditions, self.lib, &setting, &|| (self.progress)(""))
     }
 
+    /// The fit at a walked point: its real χ² (data + prior), per condition, and the
+    /// surrogate's correction there.
+    fn walked_fit(
+        &self,
+        active: Vec<usize>,
+        point: Point,
+        unit: Vec<f64>,
+        sims: Vec<SimMetrics>,
+    ) -> Fit {
+        let (data, per) = chi2_of(self.obs, &sims);
+        let correction = self.sur().correction_at(&point, &sims);
+        Fit {
+            active,
+            chi2: data + self.knobs.prior_chi2(&point),
+            point,
+            unit,
+            chi2_data: data,
+            per_condition: per,
+            real: true,
+            correction,
+            held_out: None,
+            sims: Some(sims),
+        }
+    }
+
     /// The nominal model, from real walks.
     pub fn nominal(&self) -> Result<Fit, GapError> {
         let point = self.knobs.nominal_point();
@@ -330,40 +355,18 @@ impl<'a> FitContext<'a> {
         if let Some(base) = floor
             && let Some(&new) = active.last()
         {
-            let knob = &self.knobs.list[new];
             let mut point = base.point.clone();
-            point[new] = Some(knob.nominal.unwrap_or_else(|| {
-                knob.strengthening_path(1)
-                    .first()
-                    .copied()
-                    .unwrap_or(knob.lo)
-            }));
+            point[new] = Some(self.knobs.list[new].resting());
             for &k in active {
                 if point[k].is_none() {
-                    let kn = &self.knobs.list[k];
-                    point[k] = Some(kn.nominal.unwrap_or_else(|| {
-                        kn.strengthening_path(1).first().copied().unwrap_or(kn.lo)
-                    }));
+                    point[k] = Some(self.knobs.list[k].resting());
                 }
             }
             let unit = self.unit_of(active, &point);
             let sims = self.walks(&point)?;
-            let (data, per) = chi2_of(self.obs, &sims);
-            let chi2 = data + self.knobs.prior_chi2(&point);
-            if best.as_ref().is_none_or(|b| chi2 < b.chi2) {
-                let correction = self.sur().correction_at(&point, &sims);
-                best = Some(Fit {
-                    active: active.to_vec(),
-                    point,
-                    unit,
-                    chi2,
-                    chi2_data: data,
-                    per_condition: per,
-                    real: true,
-                    correction,
-                    held_out: None,
-                    sims: Some(sims),
-                });
+            let here = self.walked_fit(active.to_vec(), point, unit, sims);
+            if best.as_ref().is_none_or(|b| here.chi2 < b.chi2) {
+                best = Some(here);
             }
         }
         best.ok_or_else(|| GapError::Invalid("a fit without a start".into()))
@@ -379,21 +382,7 @@ impl<'a> FitContext<'a> {
         for _ in 0..REFINE_ROUNDS {
             self.refine_curves(&fit.active, &point)?;
             let sims = self.walks(&point)?;
-            let (data, per) = chi2_of(self.obs, &sims);
-            let prior = self.knobs.prior_chi2(&point);
-            let correction = self.sur().correction_at(&point, &sims);
-            let here = Fit {
-                active: fit.active.clone(),
-                point: point.clone(),
-                unit: unit.clone(),
-                chi2: data + prior,
-                chi2_data: data,
-                per_condition: per,
-                real: true,
-                correction,
-                held_out: None,
-                sims: Some(sims),
-            };
+            let here = self.walked_fit(fit.active.clone(), point.clone(), unit.clone(), sims);
             let improved = best.as_ref().is_none_or(|b| here.chi2 < b.chi2 - 1e-9);
             if improved {
                 best = Some(here);
@@ -760,20 +749,9 @@ impl<'a> FitContext<'a> {
             }
             let (chi2, point, sims) = if fc.0 < fd.0 { fc } else { fd };
             if chi2 < best.chi2 - 1e-9 {
-                let (data, per) = chi2_of(self.obs, &sims);
-                let correction = self.sur().correction_at(&point, &sims);
-                best.unit[pos] = knob.to_unit(point[k].unwrap_or(x0));
-                best = Fit {
-                    point,
-                    chi2,
-                    chi2_data: data,
-                    per_condition: per,
-                    real: true,
-                    correction,
-                    held_out: None,
-                    sims: Some(sims),
-                    ..best
-                };
+                let mut unit = best.unit.clone();
+                unit[pos] = knob.to_unit(point[k].unwrap_or(x0));
+                best = self.walked_fit(best.active.clone(), point, unit, sims);
             }
         }
         if best.held_out.is_none() {

@@ -82,6 +82,17 @@ impl Knob {
         self.lo + s.clamp(0.0, 1.0) * (self.hi - self.lo)
     }
 
+    /// Where the knob rests when the model does not fit it: its nominal coordinate, or for
+    /// an effect without one its weakest setting.
+    pub fn resting(&self) -> f64 {
+        self.nominal.unwrap_or_else(|| {
+            self.strengthening_path(1)
+                .first()
+                .copied()
+                .unwrap_or(self.lo)
+        })
+    }
+
     /// The prior's χ² charge of a coordinate (0 without a prior).
     pub fn prior_chi2(&self, x: f64) -> f64 {
         match self.prior {

@@ -43,6 +43,21 @@ impl SimMetrics {
     pub fn get(&self, m: Metric) -> f64 {
         self.values[m.index()]
     }
+
+    /// The metrics a trial measured, as if simulated (exact trials of another engine taken
+    /// as the truth): NaN where it measured nothing; a trial with no measured metric fell.
+    pub fn measured_by(t: &Trial) -> SimMetrics {
+        let mut values = [f64::NAN; 8];
+        for m in Metric::SIMULATED {
+            if let Some(v) = t.measured(m) {
+                values[m.index()] = v.value;
+            }
+        }
+        SimMetrics {
+            values,
+            fell: values.iter().all(|v| v.is_nan()),
+        }
+    }
 }
 
 /// Resolves the trials' designs (bundled name, or a TOML path relative to the trials file)

@@ -453,16 +453,20 @@ def analytic_spin(model, w0):
     }
 
 
-def effective_hip_inertia(model):
-    """1/(M⁻¹)_qq of the free two-body system at q = 0 (ν = v_hip, ω, q̇; world = leg axes)."""
-    M = np.zeros((7, 7))
+def hip_mass_matrix(model, q=0.0):
+    """The 7×7 mass matrix of the free two-body system with the right leg turned by q about
+    the hip's y axis (left leg upright; ν = v_hip, ω_left, q̇; world = left-leg axes)."""
     ey = np.array([0.0, 1.0, 0.0])
+    Ry = dz.rot_y(q)
 
     def skew(r):
         return np.array([[0, -r[2], r[1]], [r[2], 0, -r[0]], [-r[1], r[0], 0]])
 
+    M = np.zeros((7, 7))
     for k, leg in enumerate(model.legs):
-        r = leg.com_m
+        R = Ry if k == 1 else np.eye(3)
+        r = R @ leg.com_m
+        Ic = R @ np.diag(leg.inertia_diag_kgm2) @ R.T
         Jv = np.zeros((3, 7))
         Jv[:, 0:3] = np.eye(3)
         Jv[:, 3:6] = -skew(r)
@@ -471,7 +475,13 @@ def effective_hip_inertia(model):
         if k == 1:
             Jv[:, 6] = np.cross(ey, r)
             Jw[:, 6] = ey
-        M += leg.mass_kg * Jv.T @ Jv + Jw.T @ np.diag(leg.inertia_diag_kgm2) @ Jw
+        M += leg.mass_kg * Jv.T @ Jv + Jw.T @ Ic @ Jw
+    return M
+
+
+def effective_hip_inertia(model):
+    """1/(M⁻¹)_qq of the free two-body system at q = 0, and M (hip_mass_matrix)."""
+    M = hip_mass_matrix(model, 0.0)
     return 1.0 / np.linalg.inv(M)[6, 6], M
 
 

@@ -56,29 +56,9 @@ def relative_inertia(model):
 
 
 def relative_inertia_at(model, q):
-    """I_rel(q) = 1/(M⁻¹)_qq with the right leg turned by q about the hip's y axis (left leg
-    upright, world = left-leg axes; ν = v_hip, ω_left, q̇)."""
-    ey = np.array([0.0, 1.0, 0.0])
-    Ry = dz.rot_y(q)
-
-    def skew(r):
-        return np.array([[0, -r[2], r[1]], [r[2], 0, -r[0]], [-r[1], r[0], 0]])
-
-    M = np.zeros((7, 7))
-    for k, leg in enumerate(model.legs):
-        R = Ry if k == 1 else np.eye(3)
-        r = R @ leg.com_m
-        Ic = R @ np.diag(leg.inertia_diag_kgm2) @ R.T
-        Jv = np.zeros((3, 7))
-        Jv[:, 0:3] = np.eye(3)
-        Jv[:, 3:6] = -skew(r)
-        Jw = np.zeros((3, 7))
-        Jw[:, 3:6] = np.eye(3)
-        if k == 1:
-            Jv[:, 6] = np.cross(ey, r)
-            Jw[:, 6] = ey
-        M += leg.mass_kg * Jv.T @ Jv + Jw.T @ Ic @ Jw
-    return 1.0 / np.linalg.inv(M)[6, 6]
+    """I_rel(q) = 1/(M⁻¹)_qq with the right leg turned by q about the hip's y axis
+    (cases.hip_mass_matrix)."""
+    return 1.0 / np.linalg.inv(cz.hip_mass_matrix(model, q))[6, 6]
 
 
 def swing_ode(model, q0dot, torque, t_end, dt, mode):
