@@ -10,6 +10,7 @@
 //! whether the box can get there at all. The sample is a Latin hypercube in the parameters'
 //! own coordinates (log where the design declares `log = true`), deterministic in its seed.
 
+use rand::seq::SliceRandom;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use serde::Serialize;
@@ -74,11 +75,12 @@ pub struct MetricReach {
     pub measured: f64,
     pub sd: f64,
     pub nominal: f64,
-    /// Lowest and highest simulated value over the walking settings.
+    /// Lowest and highest simulated value over the walking sampled settings: what the box
+    /// reaches at least (a sample, not the box's true extremes).
     pub reach: [f64; 2],
     /// Value in the best setting.
     pub best: f64,
-    /// The measured value lies within the reach widened by 2 sd.
+    /// The measured value lies within the sampled reach widened by 2 sd.
     pub reachable: bool,
 }
 
@@ -92,6 +94,12 @@ pub struct Exploration {
     pub fell: usize,
     pub plausible: usize,
     pub nominal_chi2: f64,
+    /// The file's values fit within noise (p ≥ [`PLAUSIBLE_P`]).
+    pub nominal_plausible: bool,
+    /// Every sampled setting fits worse than the file's values: the sample is too sparse
+    /// for these trials (the region that fits, if any, is narrower than its spacing), and
+    /// "no plausible sample" says nothing about the box.
+    pub too_sparse: bool,
     pub best_chi2: f64,
     pub best_p: f64,
     pub parameters: Vec<ParameterReach>,
@@ -101,16 +109,13 @@ pub struct Exploration {
 }
 
 /// A Latin hypercube of `n` points in [0, 1]^dim: each coordinate's n strata each hold one
-/// point, jittered within the stratum, strata shuffled per coordinate (Fisher–Yates).
+/// point, jittered within the stratum, strata shuffled per coordinate.
 pub fn latin_hypercube(n: usize, dim: usize, seed: u64) -> Vec<Vec<f64>> {
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
     let mut columns: Vec<Vec<f64>> = Vec::with_capacity(dim);
     for _ in 0..dim {
         let mut strata: Vec<usize> = (0..n).collect();
-        for i in (1..n).rev() {
-            let j = rng.random_range(0..=i);
-            strata.swap(i, j);
-        }
+        strata.shuffle(&mut rng);
         columns.push(
             strata
                 .into_iter()
@@ -219,6 +224,18 @@ pub fn explore(
         .min_by(|a, b| chi2[*a].total_cmp(&chi2[*b]))
         .ok_or_else(|| GapError::Invalid("no sample".into()))?;
     let walking: Vec<usize> = (0..chi2.len()).filter(|i| !fell[*i]).collect();
+    if chi2[best] > nominal_chi2 {
+        notes.push(format!(
+            "every sampled setting fits worse than the file's values (best χ² {:.1} > nominal \
+             {:.1}): {} samples over {} parameters are too sparse for these trials; run \
+             `survey gap diagnose` (a local fit) or more samples before reading anything into \
+             \"no plausible setting\"",
+            chi2[best],
+            nominal_chi2,
+            opts.samples,
+            params.len()
+        ));
+    }
     if walking.len() < opts.samples {
         notes.push(format!(
             "{} of {} settings fell on some condition (χ² charged as a fall)",
@@ -299,6 +316,9 @@ pub fn explore(
         fell: opts.samples - walking.len(),
         plausible: plausible.iter().filter(|p| **p).count(),
         nominal_chi2,
+        nominal_plausible: !sims[0].iter().any(|m| m.fell)
+            && chi2_upper_p(nominal_chi2, n_obs as f64).unwrap_or(0.0) >= PLAUSIBLE_P,
+        too_sparse: chi2[best] > nominal_chi2,
         best_chi2: chi2[best],
         best_p: chi2_upper_p(chi2[best], n_obs as f64).unwrap_or(0.0),
         parameters,

@@ -497,20 +497,36 @@ pub fn exploration_md(e: &Exploration) -> String {
     );
     let verdict = if e.plausible > 0 {
         format!(
-            "**{} of {} settings fit the trials within noise** (nominal χ² = {}, best χ² = {}, p = {:.2}).",
+            "**{} of {} sampled settings fit the trials within noise** (nominal χ² = {}, best χ² = {}, p = {:.2}).",
             e.plausible,
             e.samples,
             sig(e.nominal_chi2),
             sig(e.best_chi2),
             e.best_p
         )
+    } else if e.too_sparse {
+        format!(
+            "**Cannot tell: every sampled setting fits worse than the file's values** (nominal χ² = \
+             {}{}, best of {} samples χ² = {}): the sample is too sparse for these trials; use \
+             `survey gap diagnose` (a local fit) or more samples.",
+            sig(e.nominal_chi2),
+            if e.nominal_plausible {
+                ", within noise"
+            } else {
+                ""
+            },
+            e.samples,
+            sig(e.best_chi2)
+        )
     } else {
         format!(
-            "**No setting in the declared ranges fits the trials within noise** (nominal χ² = {}, \
-             best of {} χ² = {}, p = {:.1e}): either a parameter lies outside its declared range, \
-             a parameter not declared uncertain is off, or the model lacks an effect.",
-            sig(e.nominal_chi2),
+            "**None of the {} sampled settings fits the trials within noise** (nominal χ² = {}, \
+             best χ² = {}, p = {:.1e}): either a parameter lies outside its declared range, a \
+             parameter not declared uncertain is off, or the model lacks an effect — unless the \
+             settings that fit lie between the samples (the reach below is what the sample \
+             attains, a lower bound on the box's).",
             e.samples,
+            sig(e.nominal_chi2),
             sig(e.best_chi2),
             e.best_p
         )
@@ -519,7 +535,7 @@ pub fn exploration_md(e: &Exploration) -> String {
     let _ = writeln!(o, "## What each measurement can reach\n");
     let _ = writeln!(
         o,
-        "| trial | metric | measured | sd | nominal | lowest – highest over the sample | best setting | reachable |"
+        "| trial | metric | measured | sd | nominal | lowest – highest over the sample | best setting | reachable by the sample |"
     );
     let _ = writeln!(o, "|---|---|---:|---:|---:|---|---:|---|");
     for m in &e.metrics {

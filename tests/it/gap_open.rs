@@ -282,18 +282,7 @@ fn a_drake_made_null_case_is_not_blamed_on_an_effect() {
     let truth: Vec<_> = golden
         .trials
         .iter()
-        .map(|t| {
-            let mut values = [f64::NAN; 8];
-            for m in Metric::SIMULATED {
-                if let Some(v) = t.measured(m) {
-                    values[m.index()] = v.value;
-                }
-            }
-            robot_survey::gap::simulate::SimMetrics {
-                values,
-                fell: false,
-            }
-        })
+        .map(robot_survey::gap::simulate::SimMetrics::measured_by)
         .collect();
     let set = TrialSet {
         origin: "drake null".into(),
@@ -494,4 +483,48 @@ fn explore_rejects_designs_without_uncertain_parameters_and_tiny_samples() {
     let o = survey(&["gap", "explore", "--trials", t, "--samples", "1"]);
     assert_ne!(o.status.code(), Some(0));
     assert!(stderr(&o).contains("at least 2 samples"), "{}", stderr(&o));
+}
+
+/// Where `explore`'s assumption fails — a sample too sparse for tight trials, made by an error
+/// in a value the design does not declare (its mass, +20 %) with every declared parameter at
+/// its file value — the best sampled setting fits worse than the file's values, and the
+/// verdict must say "cannot tell", not "no plausible setting".
+#[test]
+fn explore_says_cannot_tell_when_its_sample_is_too_sparse() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let trials = dir.path().join("mass.csv");
+    let t = trials.to_str().expect("utf-8");
+    let o = survey(&[
+        "gap",
+        "synth",
+        "--set",
+        "mass.total_mass_kg=1.08",
+        "--noise",
+        "0.03",
+        "--seed",
+        "21",
+        "--out",
+        t,
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let o = survey(&[
+        "gap",
+        "explore",
+        "--trials",
+        t,
+        "--samples",
+        "16",
+        "--format",
+        "json",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let e: serde_json::Value = serde_json::from_str(&stdout(&o)).expect("json");
+    let (best, nominal) = (
+        e["best_chi2"].as_f64().expect("best"),
+        e["nominal_chi2"].as_f64().expect("nominal"),
+    );
+    assert!(best > nominal, "best sample {best} vs nominal {nominal}");
+    assert_eq!(e["too_sparse"], true);
+    let o = survey(&["gap", "explore", "--trials", t, "--samples", "16"]);
+    assert!(stdout(&o).contains("**Cannot tell"), "{}", stdout(&o));
 }
