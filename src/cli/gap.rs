@@ -30,6 +30,19 @@ pub enum GapCommand {
     /// a Latin hypercube over their whole ranges (history matching), what each parameter
     /// is pinned to, and how far each measured metric can be reached.
     Explore(ExploreArgs),
+    /// Tell look-alike explanations apart: fit each candidate (an effect or a declared
+    /// parameter) by walks on the summaries alone and on summaries + the logged cycles
+    /// (trials whose `trajectory` column names a log), rank them, name one only when it fits
+    /// within noise and beats every rival.
+    Separate(SeparateArgs),
+    /// The next trials to run: the conditions at the robot's own size (drive frequency,
+    /// amplitude, payload, slope) where the two leading candidates differ most, computed
+    /// with the simulator.
+    Suggest(SuggestArgs),
+    /// What the logged cycles buy: look-alike pairs of effects, each side the truth at
+    /// multiples of its identification threshold, separated on summaries only and on
+    /// summaries + waveforms over noise seeds (reports/gap-waveforms.md).
+    WaveformBenchmark(WaveformBenchArgs),
     /// Every effect at several magnitudes × noise levels × seeds, plus null cases:
     /// identification confusion matrix, parameter recovery, shrink.
     Benchmark(BenchmarkArgs),
@@ -83,6 +96,18 @@ pub struct SynthArgs {
     /// Output trials CSV.
     #[arg(long, value_name = "FILE")]
     pub out: PathBuf,
+    /// Also write each trial's log (time, hip angle, roll/pitch/yaw, hip torque, with white
+    /// sensor noise) into this folder, named in the trials' `trajectory` column: the input of
+    /// `survey gap separate`'s waveform evidence.
+    #[arg(long, value_name = "DIR")]
+    pub logs: Option<PathBuf>,
+    /// Sensor noise of the logs' angles: sd of each sample [deg].
+    #[arg(long, default_value_t = 0.3, requires = "logs")]
+    pub sensor_noise_deg: f64,
+    /// Sensor noise of the logs' hip torque: sd of each sample as a fraction of the log's
+    /// largest |torque|.
+    #[arg(long, default_value_t = 0.03, requires = "logs")]
+    pub sensor_noise_torque: f64,
 }
 
 #[derive(Args, Debug)]
@@ -143,6 +168,104 @@ pub struct ExploreArgs {
 
 #[derive(Args, Debug)]
 #[command(after_help = "Examples:\n  \
+survey gap synth --effect hip_coulomb_friction=0.02 --noise 0.03 --seed 1 --out t.csv --logs logs/\n  \
+survey gap separate --trials t.csv --candidates hip_coulomb_friction,hip_viscous_damping --plot cycles.svg\n\n\
+A log needs the columns t_s, hip_angle_deg, roll_deg, pitch_deg, yaw_deg (hip_torque_nm and \
+drive_phase_cycles optional; dataset/trials/README.md). Each candidate is fitted alone, the other \
+knobs at the design file's values. Exit code 0 whatever the verdict.")]
+pub struct SeparateArgs {
+    /// Trials CSV (format: dataset/trials/README.md); rows may name a log in `trajectory`.
+    #[arg(long, value_name = "FILE")]
+    pub trials: PathBuf,
+    /// Two or more knobs: effect names (`survey gap effects`) or `design:path` of declared
+    /// uncertain parameters (e.g. mugatu:control.kp_nm_per_rad).
+    #[arg(long, value_delimiter = ',', required = true, num_args = 1..)]
+    pub candidates: Vec<String>,
+    /// Model-error floor of a cycle coefficient, as a fraction of the measured signal's RMS.
+    #[arg(long, default_value_t = 0.05)]
+    pub waveform_floor: f64,
+    /// Drive cycles left out at the start of every log and walk.
+    #[arg(long, default_value_t = 6)]
+    pub settle_cycles: usize,
+    /// Walks per candidate over its range before the refinement.
+    #[arg(long, default_value_t = 9)]
+    pub grid: usize,
+    /// False-alarm rate of the tests between candidates (and of the "fits within noise" test).
+    #[arg(long, default_value_t = 0.01)]
+    pub alpha: f64,
+    /// Relative sd assumed where a measurement states none.
+    #[arg(long, default_value_t = 0.10)]
+    pub default_sd: f64,
+    #[arg(long, value_enum, default_value_t)]
+    pub format: GapFormat,
+    /// Figure of the measured cycles against the nominal and the best candidate (SVG or PNG).
+    #[arg(long, value_name = "FILE")]
+    pub plot: Option<PathBuf>,
+}
+
+#[derive(Args, Debug)]
+#[command(after_help = "Example:\n  \
+survey gap suggest --trials t.csv --candidates hip_coulomb_friction,hip_viscous_damping --budget 3 --out next.csv\n\n\
+The candidates are fitted to the trials (as `survey gap separate`); the two leading ones are \
+walked on every condition of the pool (drive frequency 0.85-1.15x the design's, servo amplitude \
+0.8-1.2x, payload 0-30 %, slope -2..2 deg, at the robot's own size); a condition is offered only \
+where the nominal and both candidates walk. The score is the expected likelihood-ratio statistic \
+between the two on that trial: summaries at the trials' median relative sd, plus the cycles when \
+the trials have logs.")]
+pub struct SuggestArgs {
+    /// Trials CSV (format: dataset/trials/README.md).
+    #[arg(long, value_name = "FILE")]
+    pub trials: PathBuf,
+    /// Two or more candidate knobs (as for `survey gap separate`).
+    #[arg(long, value_delimiter = ',', required = true, num_args = 1..)]
+    pub candidates: Vec<String>,
+    /// How many trials to suggest.
+    #[arg(long, default_value_t = 3)]
+    pub budget: usize,
+    /// Model-error floor of a cycle coefficient (fraction of the signal's RMS).
+    #[arg(long, default_value_t = 0.05)]
+    pub waveform_floor: f64,
+    /// Relative sd assumed for the new trials when the trials state none.
+    #[arg(long, default_value_t = 0.05)]
+    pub default_sd: f64,
+    /// Write the suggested conditions as a trials CSV to fill in.
+    #[arg(long, value_name = "FILE")]
+    pub out: Option<PathBuf>,
+    #[arg(long, value_enum, default_value_t)]
+    pub format: GapFormat,
+}
+
+#[derive(Args, Debug)]
+#[command(
+    after_help = "Example:\n  survey gap waveform-benchmark --seeds 8 --out reports/\n\n\
+Each pair is A:B (both sides are taken as the truth in turn). Thresholds: the summaries' \
+identification threshold of the truth against the other effects of the library, at --noise."
+)]
+pub struct WaveformBenchArgs {
+    #[arg(long, default_value = "mugatu")]
+    pub design: String,
+    /// Look-alike pairs A:B, comma-separated (default: Coulomb:damping, latency:backlash,
+    /// soft ground:backlash).
+    #[arg(long, value_delimiter = ',', value_name = "A:B")]
+    pub pairs: Vec<String>,
+    /// Truth magnitudes as multiples of its identification threshold.
+    #[arg(long, value_delimiter = ',', default_value = "0.5,1,2")]
+    pub multiples: Vec<f64>,
+    #[arg(long, default_value_t = 8)]
+    pub seeds: u64,
+    /// Relative sd of the summaries' noise.
+    #[arg(long, default_value_t = 0.03)]
+    pub noise: f64,
+    /// Model-error floor of a cycle coefficient (fraction of the signal's RMS).
+    #[arg(long, default_value_t = 0.05)]
+    pub waveform_floor: f64,
+    /// Folder for gap-waveforms.md and .json.
+    #[arg(long, value_name = "DIR", default_value = "reports")]
+    pub out: PathBuf,
+}
+
+#[derive(Args, Debug)]
+#[command(after_help = "Examples:\n  \
 survey gap benchmark --drake tests/golden/drake/gap --points bench.csv --out reports/\n  \
 survey gap benchmark --drake tests/golden/drake/gap --points b-2.csv --shard 2/4   # one slice\n  \
 survey gap benchmark --drake tests/golden/drake/gap --merge b-1.csv b-2.csv b-3.csv b-4.csv --points bench.csv --out reports/\n  \
@@ -197,6 +320,9 @@ pub fn run(a: &GapArgs) -> anyhow::Result<ExitCode> {
         GapCommand::Synth(s) => synth(s),
         GapCommand::Diagnose(d) => diagnose(d),
         GapCommand::Explore(e) => explore(e),
+        GapCommand::Separate(s) => separate(s),
+        GapCommand::Suggest(s) => suggest(s),
+        GapCommand::WaveformBenchmark(w) => waveform_benchmark(w),
         GapCommand::Benchmark(b) => benchmark(b),
     }
 }
@@ -262,10 +388,214 @@ fn synth(a: &SynthArgs) -> anyhow::Result<ExitCode> {
         noise: a.noise,
         seed: a.seed,
     };
-    let set = gap::synth::synthesize(&lib, &opts, conditions, &command, &|| pb.inc(1))?;
+    let Some(dir) = &a.logs else {
+        let set = gap::synth::synthesize(&lib, &opts, conditions, &command, &|| pb.inc(1))?;
+        pb.finish_and_clear();
+        write_atomic(&a.out, set.to_csv().as_bytes())?;
+        eprintln!("wrote {} ({} trials)", a.out.display(), set.trials.len());
+        return Ok(ExitCode::SUCCESS);
+    };
+    if !(a.sensor_noise_deg >= 0.0 && a.sensor_noise_deg.is_finite()) {
+        anyhow::bail!("--sensor-noise-deg {}: must be ≥ 0", a.sensor_noise_deg);
+    }
+    if !(a.sensor_noise_torque >= 0.0 && a.sensor_noise_torque < 1.0) {
+        anyhow::bail!(
+            "--sensor-noise-torque {}: must be a fraction in [0, 1)",
+            a.sensor_noise_torque
+        );
+    }
+    command.push_str(&format!(
+        " --logs {} --sensor-noise-deg {} --sensor-noise-torque {}",
+        dir.display(),
+        a.sensor_noise_deg,
+        a.sensor_noise_torque
+    ));
+    let sensor = gap::waveform::SensorNoise {
+        angle_deg: a.sensor_noise_deg,
+        torque_fraction: a.sensor_noise_torque,
+    };
+    let (mut set, logs) =
+        gap::synth::synthesize_logs(&lib, &opts, conditions, &command, sensor, &|| pb.inc(1))?;
     pb.finish_and_clear();
+    std::fs::create_dir_all(dir).map_err(|e| anyhow::anyhow!("{}: {e}", dir.display()))?;
+    // The trials file names each log relative to its own folder.
+    let out_dir = a
+        .out
+        .parent()
+        .filter(|p| !p.as_os_str().is_empty())
+        .unwrap_or(std::path::Path::new("."));
+    let rel_dir = relative_to(dir, out_dir);
+    for (i, (t, log)) in set.trials.iter_mut().zip(&logs).enumerate() {
+        let name = if t.label.is_empty() {
+            format!("trial-{}.csv", i + 1)
+        } else {
+            format!("{}.csv", t.label)
+        };
+        write_atomic(
+            &dir.join(&name),
+            gap::waveform::log_csv_text(log).as_bytes(),
+        )?;
+        t.trajectory = Some(rel_dir.join(&name).to_string_lossy().replace('\\', "/"));
+    }
     write_atomic(&a.out, set.to_csv().as_bytes())?;
-    eprintln!("wrote {} ({} trials)", a.out.display(), set.trials.len());
+    eprintln!(
+        "wrote {} ({} trials) and {} logs in {}",
+        a.out.display(),
+        set.trials.len(),
+        logs.len(),
+        dir.display()
+    );
+    Ok(ExitCode::SUCCESS)
+}
+
+/// `path` relative to `base` when both are relative or both absolute and `path` lies under
+/// `base`'s canonical form; otherwise `path` made absolute (a trials file must find its logs).
+fn relative_to(path: &std::path::Path, base: &std::path::Path) -> PathBuf {
+    match (path.canonicalize(), base.canonicalize()) {
+        (Ok(p), Ok(b)) => {
+            // Walk up from base until p starts with it, counting `..`.
+            let mut up = PathBuf::new();
+            let mut anc = b.as_path();
+            loop {
+                if let Ok(rest) = p.strip_prefix(anc) {
+                    return up.join(rest);
+                }
+                match anc.parent() {
+                    Some(parent) => {
+                        up.push("..");
+                        anc = parent;
+                    }
+                    None => return p,
+                }
+            }
+        }
+        _ => path.to_path_buf(),
+    }
+}
+
+fn separate(a: &SeparateArgs) -> anyhow::Result<ExitCode> {
+    let lib = EffectLibrary::bundled()?;
+    let set = TrialSet::read(&a.trials)?;
+    let opts = gap::separate::SeparateOptions {
+        candidates: a.candidates.clone(),
+        grid_points: a.grid,
+        relative_floor: a.waveform_floor,
+        settle_cycles: a.settle_cycles,
+        alpha: a.alpha,
+        default_relative_sd: a.default_sd,
+        ..Default::default()
+    };
+    let pb = indicatif::ProgressBar::new_spinner();
+    pb.set_message("walking the candidates");
+    let s = gap::separate::separate(&set, &lib, &opts, &|| pb.tick())?;
+    pb.finish_and_clear();
+    eprintln!("{} walks", s.walks);
+    if let Some(p) = &a.plot {
+        report::separation::cycles_plot(&s, p)?;
+        eprintln!("wrote {}", p.display());
+    }
+    print(&match a.format {
+        GapFormat::Json => report::json(&s)?,
+        GapFormat::Text => report::separation::separation_md(&s),
+    });
+    Ok(ExitCode::SUCCESS)
+}
+
+fn suggest(a: &SuggestArgs) -> anyhow::Result<ExitCode> {
+    let lib = EffectLibrary::bundled()?;
+    let set = TrialSet::read(&a.trials)?;
+    if !(a.default_sd > 0.0 && a.default_sd < 1.0) {
+        anyhow::bail!(
+            "--default-sd {}: must be a fraction in (0, 1)",
+            a.default_sd
+        );
+    }
+    let opts = gap::suggest::SuggestOptions {
+        budget: a.budget,
+        separate: gap::separate::SeparateOptions {
+            candidates: a.candidates.clone(),
+            relative_floor: a.waveform_floor,
+            ..Default::default()
+        },
+        default_relative_sd: a.default_sd,
+    };
+    let pb = indicatif::ProgressBar::new_spinner();
+    pb.set_message("fitting the candidates, then walking the pool");
+    let s = gap::suggest::suggest(&set, &lib, &opts, &|| pb.tick())?;
+    pb.finish_and_clear();
+    if let Some(p) = &a.out {
+        let next = TrialSet {
+            origin: p.display().to_string(),
+            base_dir: PathBuf::from("."),
+            trials: gap::suggest::as_trials(&s),
+        };
+        write_atomic(p, next.to_csv().as_bytes())?;
+        eprintln!(
+            "wrote {} ({} conditions to run)",
+            p.display(),
+            next.trials.len()
+        );
+    }
+    print(&match a.format {
+        GapFormat::Json => report::json(&s)?,
+        GapFormat::Text => report::separation::suggestion_md(&s),
+    });
+    Ok(ExitCode::SUCCESS)
+}
+
+fn waveform_benchmark(a: &WaveformBenchArgs) -> anyhow::Result<ExitCode> {
+    let lib = EffectLibrary::bundled()?;
+    let mut opts = gap::waveform_bench::WaveformBenchOptions::standard(&a.design);
+    if !a.pairs.is_empty() {
+        opts.pairs = a
+            .pairs
+            .iter()
+            .map(|p| {
+                p.split_once(':')
+                    .map(|(x, y)| (x.trim().to_string(), y.trim().to_string()))
+                    .ok_or_else(|| anyhow::anyhow!("--pairs {p}: expected A:B"))
+            })
+            .collect::<anyhow::Result<_>>()?;
+    }
+    if let Some(bad) = a.multiples.iter().find(|m| !(**m > 0.0 && m.is_finite())) {
+        anyhow::bail!("--multiples {bad}: each must be a positive number");
+    }
+    if !(a.noise > 0.0 && a.noise < 1.0) {
+        anyhow::bail!("--noise {}: must be a fraction in (0, 1)", a.noise);
+    }
+    opts.multiples = a.multiples.clone();
+    opts.seeds = a.seeds.max(1);
+    opts.noise = a.noise;
+    opts.separate.relative_floor = a.waveform_floor;
+    let mut command = format!(
+        "survey gap waveform-benchmark --design {} --seeds {} --noise {} --waveform-floor {} --multiples {}",
+        a.design,
+        opts.seeds,
+        a.noise,
+        a.waveform_floor,
+        a.multiples
+            .iter()
+            .map(|m| m.to_string())
+            .collect::<Vec<_>>()
+            .join(",")
+    );
+    if !a.pairs.is_empty() {
+        command.push_str(&format!(" --pairs {}", a.pairs.join(",")));
+    }
+    let started = std::time::Instant::now();
+    let b = gap::waveform_bench::run(&lib, &opts, &|line| eprintln!("{line}"))?;
+    let elapsed = started.elapsed().as_secs_f64();
+    std::fs::create_dir_all(&a.out).map_err(|e| anyhow::anyhow!("{}: {e}", a.out.display()))?;
+    let md = a.out.join("gap-waveforms.md");
+    write_atomic(
+        &md,
+        report::separation::waveform_bench_md(&b, &command).as_bytes(),
+    )?;
+    write_atomic(
+        &a.out.join("gap-waveforms.json"),
+        report::json(&b)?.as_bytes(),
+    )?;
+    eprintln!("wrote {} ({} walks, {elapsed:.0} s)", md.display(), b.walks);
     Ok(ExitCode::SUCCESS)
 }
 
@@ -315,9 +645,29 @@ fn diagnose(a: &DiagnoseArgs) -> anyhow::Result<ExitCode> {
         report::gap::residual_plot(&d, p)?;
         eprintln!("wrote {}", p.display());
     }
+    // Look-alike groups the summaries left, separated with the trials' logs (when they have
+    // any). Text only: the JSON stays the diagnosis (`survey gap separate --format json`
+    // gives a group's separation as JSON).
+    let follow = match a.format {
+        GapFormat::Text => gap::separate::follow_up(
+            &d,
+            &set,
+            &lib,
+            &gap::separate::SeparateOptions::default(),
+            &|| {},
+        )?,
+        GapFormat::Json => Vec::new(),
+    };
     print(&match a.format {
         GapFormat::Json => report::json(&d)?,
-        GapFormat::Text => report::gap::diagnosis_md(&d),
+        GapFormat::Text => {
+            let mut text = report::gap::diagnosis_md(&d);
+            for s in &follow {
+                text.push_str("\n## The look-alike group, with the logged cycles\n\n");
+                text.push_str(&report::separation::separation_md(s));
+            }
+            text
+        }
     });
     Ok(ExitCode::SUCCESS)
 }

@@ -305,7 +305,7 @@ pub fn thresholds(
 /// The magnitude (SI) `multiple` times as strong as `threshold`, away from the effect's
 /// off value, kept inside the plausible range by a margin of 15 % (in log): a truth at a
 /// range end is never called (the fit cannot tell it from one beyond), by design.
-fn magnitude_at(
+pub(crate) fn magnitude_at(
     lib: &EffectLibrary,
     design: &Design,
     effect: &str,

@@ -224,6 +224,11 @@ fn fill_from_trajectories(
             column: 0,
             message,
         };
+        // A robot's log (time, hip angle, attitude) has no hip position or contact forces:
+        // its summaries come from the row; its cycles serve `survey gap separate`.
+        if !super::waveform::is_full_trajectory(&path)? {
+            continue;
+        }
         let samples = crate::sim::read_trajectory_csv(&path)
             .map_err(|e| at(format!("trajectory {}: {e}", path.display())))?;
         let d = c.design_with(lib, &super::knob::ModelSetting::nominal())?;

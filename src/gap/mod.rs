@@ -33,11 +33,15 @@ pub mod library;
 pub mod locate;
 pub mod problem;
 pub mod select;
+pub mod separate;
 pub mod simulate;
 pub mod solver;
+pub mod suggest;
 pub mod surrogate;
 pub mod synth;
 pub mod trials;
+pub mod waveform;
+pub mod waveform_bench;
 
 pub use diagnose::{DiagnoseOptions, Diagnosis, diagnose};
 pub use error::GapError;

@@ -212,11 +212,22 @@ impl Condition {
         lib: &EffectLibrary,
         setting: &ModelSetting,
     ) -> Result<SimMetrics, GapError> {
+        self.walk(lib, setting, false).map(|(m, _)| m)
+    }
+
+    /// Simulates the condition under `setting`: the metrics and the trajectory (kept when
+    /// `record`; the drive phase is f·t).
+    pub fn walk(
+        &self,
+        lib: &EffectLibrary,
+        setting: &ModelSetting,
+        record: bool,
+    ) -> Result<(SimMetrics, Vec<crate::sim::TrajectorySample>), GapError> {
         let d = self.design_with(lib, setting)?;
         let f = d.controller().frequency_hz().unwrap_or(1.0);
         let opts = WalkOptions {
             duration_s: CYCLES_PER_TRIAL / f,
-            record_trajectory: false,
+            record_trajectory: record,
             ..WalkOptions::default()
         };
         let r = simulate_walk(&d, &opts).map_err(|e| GapError::Sim {
@@ -230,7 +241,7 @@ impl Condition {
                 values[m.index()] = m.of_report(&r.report);
             }
         }
-        Ok(SimMetrics { values, fell })
+        Ok((SimMetrics { values, fell }, r.trajectory))
     }
 }
 

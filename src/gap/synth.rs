@@ -151,22 +151,45 @@ pub fn synthesize(
     command: &str,
     progress: &(dyn Fn() + Sync),
 ) -> Result<TrialSet, GapError> {
-    if !(opts.noise >= 0.0 && opts.noise.is_finite() && opts.noise < 1.0) {
+    check_noise(opts.noise)?;
+    let set = conditions_or_default(opts, conditions)?;
+    let resolved = resolve(&set)?;
+    let setting = setting_of(opts, &resolved);
+    let truth = truth_metrics(&resolved, lib, &setting, progress)?;
+    let trials = add_noise(&set.trials, &truth, opts.noise, opts.seed, command);
+    Ok(TrialSet {
+        origin: set.origin,
+        base_dir: set.base_dir,
+        trials,
+    })
+}
+
+fn check_noise(noise: f64) -> Result<(), GapError> {
+    if !(noise >= 0.0 && noise.is_finite() && noise < 1.0) {
         return Err(GapError::Invalid(format!(
-            "--noise {}: must be a fraction in [0, 1)",
-            opts.noise
+            "--noise {noise}: must be a fraction in [0, 1)"
         )));
     }
-    let set = match conditions {
+    Ok(())
+}
+
+fn conditions_or_default(
+    opts: &SynthOptions,
+    conditions: Option<TrialSet>,
+) -> Result<TrialSet, GapError> {
+    Ok(match conditions {
         Some(s) => s,
         None => TrialSet {
             origin: format!("default conditions of {}", opts.design),
             base_dir: std::path::PathBuf::from("."),
             trials: default_conditions(&opts.design)?,
         },
-    };
-    let resolved = resolve(&set)?;
-    let setting = ModelSetting {
+    })
+}
+
+/// The parameter values (on every design of the trials) and effects of the synthetic robot.
+fn setting_of(opts: &SynthOptions, resolved: &[Condition]) -> ModelSetting {
+    ModelSetting {
         params: resolved
             .iter()
             .map(|c| c.design.name.clone())
@@ -179,14 +202,7 @@ pub fn synthesize(
             })
             .collect(),
         effects: opts.effects.clone(),
-    };
-    let truth = truth_metrics(&resolved, lib, &setting, progress)?;
-    let trials = add_noise(&set.trials, &truth, opts.noise, opts.seed, command);
-    Ok(TrialSet {
-        origin: set.origin,
-        base_dir: set.base_dir,
-        trials,
-    })
+    }
 }
 
 /// The true metrics of the conditions under `setting` (parameter values and effects).
@@ -205,4 +221,48 @@ pub fn truth_metrics(
             r
         })
         .collect()
+}
+
+/// [`synthesize`] plus a log of every trial (the signals a robot records, with white sensor
+/// noise): the summaries are exactly [`synthesize`]'s for the same options, the logs add the
+/// cycles. A fallen walk's log is kept (it shows the fall). Deterministic in the seed.
+pub fn synthesize_logs(
+    lib: &EffectLibrary,
+    opts: &SynthOptions,
+    conditions: Option<TrialSet>,
+    command: &str,
+    sensor: super::waveform::SensorNoise,
+    progress: &(dyn Fn() + Sync),
+) -> Result<(TrialSet, Vec<Vec<super::waveform::LogSample>>), GapError> {
+    use rayon::prelude::*;
+    check_noise(opts.noise)?;
+    let set = conditions_or_default(opts, conditions)?;
+    let resolved = resolve(&set)?;
+    let setting = setting_of(opts, &resolved);
+    let walked: Vec<(SimMetrics, Vec<crate::sim::TrajectorySample>)> = resolved
+        .par_iter()
+        .map(|c| {
+            let r = c.walk(lib, &setting, true);
+            progress();
+            r
+        })
+        .collect::<Result<_, _>>()?;
+    let truth: Vec<SimMetrics> = walked.iter().map(|w| w.0).collect();
+    let trials = add_noise(&set.trials, &truth, opts.noise, opts.seed, command);
+    let logs = walked
+        .iter()
+        .enumerate()
+        .map(|(i, (_, tr))| {
+            let seed = opts.seed ^ (0x9E37_79B9_7F4A_7C15u64.wrapping_mul(i as u64 + 1));
+            super::waveform::add_sensor_noise(&super::waveform::log_of(tr), sensor, seed)
+        })
+        .collect();
+    Ok((
+        TrialSet {
+            origin: set.origin,
+            base_dir: set.base_dir,
+            trials,
+        },
+        logs,
+    ))
 }

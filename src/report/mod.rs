@@ -6,6 +6,7 @@ mod diff;
 pub mod gap;
 pub mod html;
 pub mod plot;
+pub mod separation;
 pub mod study;
 
 pub use diff::diff_md;

@@ -7,6 +7,7 @@ mod diff;
 mod drake_crosscheck;
 mod gap;
 mod gap_open;
+mod gap_waveform;
 mod live_dataset;
 mod load_fuzz;
 mod min_torque;

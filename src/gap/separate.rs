@@ -1,0 +1,676 @@
+//! Telling look-alike explanations apart: each candidate knob (an effect's magnitude or a
+//! declared uncertain parameter, the rest at the file's values) is fitted to the trials by
+//! real walks, once on the summary metrics alone and once on the summaries plus the logged
+//! cycles ([`super::waveform`]), and the candidates are ranked by χ² in each mode.
+//!
+//! The rules that keep a name honest, in each mode:
+//! * a candidate is named only if it fits within noise (χ² p ≥ α over all observations):
+//!   the best of several wrong candidates is still wrong, and ranking them would name it;
+//! * and only if every rival is worse by more than the likelihood-ratio test allows at
+//!   α/(K−1), with the Δχ² divided by the over-dispersion left at the best fit;
+//! * otherwise the answer is "cannot tell" (with the group that stays within reach), or
+//!   "none fits" (with where the rest lies), or "no gap" when the nominal fits already.
+
+use std::collections::HashMap;
+use std::sync::{Arc, Mutex};
+
+use rayon::prelude::*;
+use serde::Serialize;
+
+use super::diagnose::{designs_of, measured};
+use super::error::GapError;
+use super::knob::{KnobKind, Knobs};
+use super::library::EffectLibrary;
+use super::problem::{FELL_Z2, Observation};
+use super::simulate::{Condition, SimMetrics, resolve};
+use super::trials::TrialSet;
+use super::waveform::{self, CycleSignature, Signal};
+use crate::regression::dist::chi2_upper_p;
+
+#[derive(Clone, Debug)]
+pub struct SeparateOptions {
+    /// Knob labels: effect names, or `design:path` of declared uncertain parameters.
+    pub candidates: Vec<String>,
+    /// Walks per candidate over its range before the golden-section refinement.
+    pub grid_points: usize,
+    /// Golden-section steps on walks around the best grid node.
+    pub refine_steps: usize,
+    /// Model-error floor of a cycle coefficient, as a fraction of the measured signal's RMS.
+    pub relative_floor: f64,
+    /// Drive cycles left out at the start of every log and simulated walk.
+    pub settle_cycles: usize,
+    pub alpha: f64,
+    /// Relative sd assumed for a measurement that states none.
+    pub default_relative_sd: f64,
+}
+
+impl Default for SeparateOptions {
+    fn default() -> Self {
+        SeparateOptions {
+            candidates: Vec::new(),
+            grid_points: 9,
+            refine_steps: 10,
+            relative_floor: 0.05,
+            settle_cycles: 6,
+            alpha: 0.01,
+            default_relative_sd: 0.10,
+        }
+    }
+}
+
+/// Which evidence a ranking uses.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Evidence {
+    Summaries,
+    SummariesAndWaveforms,
+}
+
+impl Evidence {
+    pub fn label(self) -> &'static str {
+        match self {
+            Evidence::Summaries => "summaries only",
+            Evidence::SummariesAndWaveforms => "summaries + waveforms",
+        }
+    }
+}
+
+/// One candidate's best fit under one kind of evidence.
+#[derive(Clone, Debug, Serialize)]
+pub struct CandidateFit {
+    pub knob: String,
+    pub kind: KnobKind,
+    /// Fitted value: SI at the first design's 1× for effects, the field's unit for
+    /// parameters.
+    pub value: f64,
+    pub unit: String,
+    /// At an end of the candidate's range.
+    pub at_range_end: bool,
+    pub chi2_summaries: f64,
+    pub chi2_waveforms: f64,
+    /// The ranked χ² (summaries, or summaries + waveforms).
+    pub chi2: f64,
+    /// (χ² − best χ²) / over-dispersion: the likelihood-ratio statistic against the best.
+    pub delta: f64,
+    /// The rival is worse than the best beyond the test (always false for the best).
+    pub separated: bool,
+}
+
+/// The answer of one ranking.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+#[serde(tag = "kind", rename_all = "snake_case")]
+pub enum Verdict {
+    /// No candidate beats the nominal model by the likelihood-ratio test: nothing to
+    /// separate.
+    NoGap,
+    /// One candidate fits within noise and every rival is worse beyond the test.
+    Named { knob: String },
+    /// The candidates within reach of the best: the trials cannot tell them apart.
+    CannotTell { group: Vec<String> },
+    /// No candidate fits within noise; where the best one's rest lies.
+    NoneFits { rest_in: String },
+}
+
+#[derive(Clone, Debug, Serialize)]
+pub struct Ranking {
+    pub evidence: Evidence,
+    /// Best first.
+    pub fits: Vec<CandidateFit>,
+    pub nominal_chi2: f64,
+    /// Observations: summary metrics plus (with waveforms) cycle coefficients.
+    pub observations: usize,
+    /// χ²/(n − 1) at the best fit, at least 1 (the worst block of evidence).
+    pub overdispersion: f64,
+    /// χ² p-value of the best fit, the worst block's, Bonferroni-adjusted over the blocks
+    /// (within noise when ≥ α).
+    pub best_p_value: f64,
+    pub verdict: Verdict,
+}
+
+/// Cycles of one trial for the figure: measured, nominal and best candidate (waveform mode).
+#[derive(Clone, Debug, Serialize)]
+pub struct TrialCycles {
+    pub trial: String,
+    pub measured: CycleSignature,
+    pub nominal: Option<CycleSignature>,
+    pub best: Option<CycleSignature>,
+    pub best_knob: String,
+}
+
+#[derive(Clone, Debug, Serialize)]
+pub struct Separation {
+    pub trials: usize,
+    pub trials_with_logs: usize,
+    pub relative_floor: f64,
+    pub alpha: f64,
+    pub rankings: Vec<Ranking>,
+    pub cycles: Vec<TrialCycles>,
+    pub notes: Vec<String>,
+    pub walks: usize,
+}
+
+/// Walks of candidate settings shared between separations of the same conditions (the
+/// benchmark's seeds): (knob label, coordinate bits) → the conditions' walks; the nominal is
+/// ("", 0).
+#[derive(Default)]
+pub struct CycleCache {
+    map: Mutex<HashMap<CacheKey, Arc<Vec<SimCycle>>>>,
+}
+
+/// (knob label, coordinate bits).
+type CacheKey = (String, u64);
+
+impl CycleCache {
+    fn get(&self, key: &CacheKey) -> Result<Option<Arc<Vec<SimCycle>>>, GapError> {
+        Ok(self.map.lock().map_err(poisoned)?.get(key).cloned())
+    }
+    fn put(&self, key: CacheKey, v: Arc<Vec<SimCycle>>) -> Result<(), GapError> {
+        self.map.lock().map_err(poisoned)?.insert(key, v);
+        Ok(())
+    }
+}
+
+/// The measured cycles of the trials that name a log (`trajectory` column), by trial.
+pub fn measured_signatures(
+    set: &TrialSet,
+    conditions: &[Condition],
+    settle_cycles: usize,
+) -> Result<Vec<Option<CycleSignature>>, GapError> {
+    set.trials
+        .iter()
+        .zip(conditions)
+        .map(|(t, c)| {
+            let Some(rel) = &t.trajectory else {
+                return Ok(None);
+            };
+            let at = |message: String| GapError::Trials {
+                path: set.origin.clone(),
+                line: t.line,
+                column: 0,
+                message,
+            };
+            let path = set.base_dir.join(rel);
+            let log = waveform::read_log_csv(&path)?;
+            let f = c.drive_frequency_hz()?;
+            waveform::signature(&log, f, settle_cycles)
+                .map(Some)
+                .map_err(|e| at(format!("trajectory {}: {e}", path.display())))
+        })
+        .collect()
+}
+
+/// Separates the candidates on the trials of `set`, reading the logs its rows name.
+pub fn separate(
+    set: &TrialSet,
+    lib: &EffectLibrary,
+    opts: &SeparateOptions,
+    progress: &(dyn Fn() + Sync),
+) -> Result<Separation, GapError> {
+    check(opts)?;
+    let conditions = resolve(set)?;
+    let sigs = measured_signatures(set, &conditions, opts.settle_cycles)?;
+    separate_with(
+        set,
+        &conditions,
+        &sigs,
+        lib,
+        opts,
+        &CycleCache::default(),
+        progress,
+    )
+}
+
+/// A simulated condition: its metrics and its cycles (None when it fell or is too short).
+#[derive(Clone, Debug)]
+pub struct SimCycle {
+    pub metrics: SimMetrics,
+    pub cycles: Option<CycleSignature>,
+}
+
+/// Simulates a condition under a setting, with the trajectory kept for the cycles.
+pub fn simulate_cycles(
+    c: &Condition,
+    lib: &EffectLibrary,
+    setting: &super::knob::ModelSetting,
+    settle_cycles: usize,
+) -> Result<SimCycle, GapError> {
+    let (metrics, trajectory) = c.walk(lib, setting, true)?;
+    let f = c
+        .design_with(lib, setting)?
+        .controller()
+        .frequency_hz()
+        .unwrap_or(1.0);
+    let fell = metrics.fell;
+    let cycles = if fell {
+        None
+    } else {
+        waveform::signature(&waveform::log_of(&trajectory), f, settle_cycles).ok()
+    };
+    Ok(SimCycle { metrics, cycles })
+}
+
+/// χ² of simulated conditions: (summaries, waveforms).
+fn chi2_pair(
+    obs: &[Observation],
+    sigs: &[Option<CycleSignature>],
+    sims: &[SimCycle],
+    floor: f64,
+) -> (f64, f64) {
+    let s: f64 = obs
+        .iter()
+        .map(|o| o.z2(sims[o.trial].metrics.get(o.metric)))
+        .sum();
+    let w: f64 = sigs
+        .iter()
+        .zip(sims)
+        .filter_map(|(m, s)| m.as_ref().map(|m| (m, s)))
+        .map(|(m, s)| match &s.cycles {
+            Some(c) => waveform::chi2(m, c, floor).chi2,
+            None => FELL_Z2 * coefficient_count(m) as f64,
+        })
+        .sum();
+    (s, w)
+}
+
+fn coefficient_count(m: &CycleSignature) -> usize {
+    m.signals
+        .iter()
+        .map(|s| s.coefficients.iter().filter(|c| c.is_finite()).count())
+        .sum()
+}
+
+/// [`separate`] on resolved conditions and measured cycles (the benchmark's entry: its logs
+/// are in memory).
+pub fn separate_with(
+    set: &TrialSet,
+    conditions: &[Condition],
+    sigs: &[Option<CycleSignature>],
+    lib: &EffectLibrary,
+    opts: &SeparateOptions,
+    cache: &CycleCache,
+    progress: &(dyn Fn() + Sync),
+) -> Result<Separation, GapError> {
+    check(opts)?;
+    let (_, obs, mut notes) = measured(set, conditions, lib, opts.default_relative_sd)?;
+    let designs = designs_of(conditions);
+    let effects: Vec<_> = lib.effects.iter().collect();
+    let knobs = Knobs::build(&designs, &effects, true).map_err(|e| GapError::Sim {
+        origin: "designs".into(),
+        source: e,
+    })?;
+    let mut idx = Vec::new();
+    for c in &opts.candidates {
+        let i = knobs.index_of(c).ok_or_else(|| {
+            GapError::Invalid(format!(
+                "candidate {c:?} is neither an effect of the library nor a declared uncertain \
+                 parameter of the trials' designs; the knobs are: {}",
+                knobs
+                    .list
+                    .iter()
+                    .map(|k| k.label())
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            ))
+        })?;
+        if !idx.contains(&i) {
+            idx.push(i);
+        }
+    }
+    let with_logs = sigs.iter().filter(|s| s.is_some()).count();
+    if with_logs == 0 {
+        notes.push(
+            "no trial names a log (`trajectory` column): only the summaries can separate the \
+             candidates"
+                .into(),
+        );
+    }
+    let walks = std::sync::atomic::AtomicUsize::new(0);
+    let run = |key: CacheKey,
+               setting: &super::knob::ModelSetting|
+     -> Result<Arc<Vec<SimCycle>>, GapError> {
+        if let Some(v) = cache.get(&key)? {
+            return Ok(v);
+        }
+        let r: Vec<SimCycle> = conditions
+            .par_iter()
+            .map(|c| simulate_cycles(c, lib, setting, opts.settle_cycles))
+            .collect::<Result<Vec<_>, _>>()?;
+        walks.fetch_add(conditions.len(), std::sync::atomic::Ordering::Relaxed);
+        progress();
+        let r = Arc::new(r);
+        cache.put(key, r.clone())?;
+        Ok(r)
+    };
+    let nominal = run((String::new(), 0), &super::knob::ModelSetting::nominal())?;
+    let (nom_s, nom_w) = chi2_pair(&obs, sigs, &nominal, opts.relative_floor);
+    let n_wave: usize = sigs.iter().flatten().map(coefficient_count).sum();
+
+    // Each candidate: grid, then golden section per evidence kind, all on walks.
+    struct Best {
+        x: f64,
+        sims: Arc<Vec<SimCycle>>,
+        s: f64,
+        w: f64,
+    }
+    let mut fits: Vec<[Best; 2]> = Vec::new();
+    for &k in &idx {
+        let knob = &knobs.list[k];
+        let label = knob.label();
+        let eval = |x: f64| -> Result<(Arc<Vec<SimCycle>>, f64, f64), GapError> {
+            let mut point = knobs.nominal_point();
+            point[k] = Some(x);
+            let sims = run((label.clone(), x.to_bits()), &knobs.setting(lib, &point))?;
+            let (s, w) = chi2_pair(&obs, sigs, &sims, opts.relative_floor);
+            Ok((sims, s, w))
+        };
+        let nodes = knob.nodes(opts.grid_points);
+        let mut grid = Vec::with_capacity(nodes.len());
+        for &x in &nodes {
+            grid.push(eval(x)?);
+        }
+        let pick = |mode: Evidence| -> Result<Best, GapError> {
+            let cost = |s: f64, w: f64| match mode {
+                Evidence::Summaries => s,
+                Evidence::SummariesAndWaveforms => s + w,
+            };
+            let j = (0..nodes.len())
+                .min_by(|a, b| {
+                    cost(grid[*a].1, grid[*a].2).total_cmp(&cost(grid[*b].1, grid[*b].2))
+                })
+                .unwrap_or(0);
+            let mut best = Best {
+                x: nodes[j],
+                sims: grid[j].0.clone(),
+                s: grid[j].1,
+                w: grid[j].2,
+            };
+            // Golden section between the best node's neighbours, one new walk set per step.
+            let (mut a, mut b) = (
+                nodes[j.saturating_sub(1)],
+                nodes[(j + 1).min(nodes.len() - 1)],
+            );
+            let g = (5f64.sqrt() - 1.0) / 2.0;
+            let mut c = b - g * (b - a);
+            let mut d = a + g * (b - a);
+            let mut fc = eval(c)?;
+            let mut fd = eval(d)?;
+            for step in 0..opts.refine_steps {
+                for (x, f) in [(c, &fc), (d, &fd)] {
+                    if cost(f.1, f.2) < cost(best.s, best.w) {
+                        best = Best {
+                            x,
+                            sims: f.0.clone(),
+                            s: f.1,
+                            w: f.2,
+                        };
+                    }
+                }
+                if step + 1 == opts.refine_steps {
+                    break;
+                }
+                if cost(fc.1, fc.2) < cost(fd.1, fd.2) {
+                    (b, d, fd) = (d, c, fc);
+                    c = b - g * (b - a);
+                    fc = eval(c)?;
+                } else {
+                    (a, c, fc) = (c, d, fd);
+                    d = a + g * (b - a);
+                    fd = eval(d)?;
+                }
+            }
+            Ok(best)
+        };
+        let by_summary = pick(Evidence::Summaries)?;
+        let by_both = pick(Evidence::SummariesAndWaveforms)?;
+        fits.push([by_summary, by_both]);
+    }
+
+    let mut rankings = Vec::new();
+    for (mi, mode) in [Evidence::Summaries, Evidence::SummariesAndWaveforms]
+        .into_iter()
+        .enumerate()
+    {
+        if mode == Evidence::SummariesAndWaveforms && with_logs == 0 {
+            continue;
+        }
+        let n = obs.len() + if mi == 1 { n_wave } else { 0 };
+        let cost = |s: f64, w: f64| if mi == 1 { s + w } else { s };
+        let mut list: Vec<CandidateFit> = idx
+            .iter()
+            .zip(&fits)
+            .map(|(&k, f)| {
+                let knob = &knobs.list[k];
+                let b = &f[mi];
+                let span = knob.hi - knob.lo;
+                CandidateFit {
+                    knob: knob.label(),
+                    kind: knob.kind,
+                    value: knob.si(b.x),
+                    unit: knob.unit.clone(),
+                    at_range_end: (b.x - knob.lo).abs() < 1e-3 * span
+                        || (knob.hi - b.x).abs() < 1e-3 * span,
+                    chi2_summaries: b.s,
+                    chi2_waveforms: b.w,
+                    chi2: cost(b.s, b.w),
+                    delta: 0.0,
+                    separated: false,
+                }
+            })
+            .collect();
+        list.sort_by(|a, b| a.chi2.total_cmp(&b.chi2));
+        let best = list[0].chi2;
+        // Each block of evidence (summaries; cycles) is tested on its own: pooled, a few
+        // hundred well-fitting cycle coefficients would dilute a summary gap into "no gap"
+        // (and the other way round). Bonferroni over the blocks; the over-dispersion is the
+        // worst block's.
+        let blocks: Vec<(usize, f64, f64)> = if mi == 1 {
+            vec![
+                (obs.len(), list[0].chi2_summaries, nom_s),
+                (n_wave, list[0].chi2_waveforms, nom_w),
+            ]
+        } else {
+            vec![(obs.len(), list[0].chi2_summaries, nom_s)]
+        };
+        let dof = |n: usize| (n.max(2) - 1) as f64;
+        let phi = blocks
+            .iter()
+            .map(|(n, c, _)| c / dof(*n))
+            .fold(1.0f64, f64::max);
+        let per_test = opts.alpha / (list.len() - 1) as f64;
+        for f in list.iter_mut().skip(1) {
+            f.delta = (f.chi2 - best) / phi;
+            f.separated = chi2_upper_p(f.delta, 1.0).unwrap_or(1.0) < per_test;
+        }
+        let nominal_chi2 = cost(nom_s, nom_w);
+        let nb = blocks.len() as f64;
+        let block_p = |c: f64, n: usize| (nb * chi2_upper_p(c, dof(n)).unwrap_or(0.0)).min(1.0);
+        let best_p = blocks
+            .iter()
+            .map(|(n, c, _)| block_p(*c, *n))
+            .fold(1.0f64, f64::min);
+        // A gap a candidate explains: the best candidate beats the nominal by the
+        // likelihood-ratio test (one knob: 1 dof) — an omnibus χ² over all observations
+        // misses a gap a single knob explains. But a nominal that fails the goodness-of-fit
+        // test has a gap whether or not a candidate beats it: then the answer is about the
+        // candidates' fit ("none fits"), never "no gap".
+        let lr_gap =
+            chi2_upper_p(((nominal_chi2 - best) / phi).max(0.0), 1.0).unwrap_or(0.0) < opts.alpha;
+        let nominal_fits = blocks
+            .iter()
+            .map(|(n, _, c)| block_p(*c, *n))
+            .fold(1.0f64, f64::min)
+            >= opts.alpha;
+        let verdict = if !lr_gap && nominal_fits {
+            Verdict::NoGap
+        } else if best_p < opts.alpha {
+            let b = &fits[idx
+                .iter()
+                .position(|&k| knobs.list[k].label() == list[0].knob)
+                .unwrap_or(0)][mi];
+            Verdict::NoneFits {
+                rest_in: rest_in(&obs, sigs, &b.sims, opts.relative_floor, mi == 1),
+            }
+        } else if !lr_gap {
+            Verdict::NoGap
+        } else if list.iter().skip(1).all(|f| f.separated) {
+            Verdict::Named {
+                knob: list[0].knob.clone(),
+            }
+        } else {
+            Verdict::CannotTell {
+                group: list
+                    .iter()
+                    .filter(|f| !f.separated)
+                    .map(|f| f.knob.clone())
+                    .collect(),
+            }
+        };
+        rankings.push(Ranking {
+            evidence: mode,
+            fits: list,
+            nominal_chi2,
+            observations: n,
+            overdispersion: phi,
+            best_p_value: best_p,
+            verdict,
+        });
+    }
+
+    // Cycles for the figure: every trial with a log, nominal and the waveform ranking's best.
+    let mut cycles = Vec::new();
+    if let Some(r) = rankings
+        .iter()
+        .find(|r| r.evidence == Evidence::SummariesAndWaveforms)
+    {
+        let bi = idx
+            .iter()
+            .position(|&k| knobs.list[k].label() == r.fits[0].knob)
+            .unwrap_or(0);
+        for (i, m) in sigs.iter().enumerate() {
+            let Some(m) = m else { continue };
+            cycles.push(TrialCycles {
+                trial: trial_name(set, i),
+                measured: m.clone(),
+                nominal: nominal[i].cycles.clone(),
+                best: fits[bi][1].sims[i].cycles.clone(),
+                best_knob: r.fits[0].knob.clone(),
+            });
+        }
+    }
+    Ok(Separation {
+        trials: set.trials.len(),
+        trials_with_logs: with_logs,
+        relative_floor: opts.relative_floor,
+        alpha: opts.alpha,
+        rankings,
+        cycles,
+        notes,
+        walks: walks.into_inner(),
+    })
+}
+
+fn poisoned<T>(_: T) -> GapError {
+    GapError::Invalid("internal: a walk cache lock was poisoned by a panic".into())
+}
+
+fn check(opts: &SeparateOptions) -> Result<(), GapError> {
+    let mut distinct = opts.candidates.clone();
+    distinct.sort();
+    distinct.dedup();
+    if distinct.len() < 2 {
+        return Err(GapError::Invalid(
+            "give at least two distinct candidates to separate".into(),
+        ));
+    }
+    if !(opts.alpha > 0.0 && opts.alpha < 1.0) {
+        return Err(GapError::Invalid("alpha must be in (0, 1)".into()));
+    }
+    if !(2..=64).contains(&opts.grid_points) {
+        return Err(GapError::Invalid("grid points must be in [2, 64]".into()));
+    }
+    if !(opts.relative_floor > 0.0 && opts.relative_floor < 1.0) {
+        return Err(GapError::Invalid(format!(
+            "waveform floor {}: must be a fraction in (0, 1)",
+            opts.relative_floor
+        )));
+    }
+    Ok(())
+}
+
+fn trial_name(set: &TrialSet, i: usize) -> String {
+    let t = &set.trials[i];
+    if t.label.is_empty() {
+        format!("line {}", t.line)
+    } else {
+        t.label.clone()
+    }
+}
+
+/// The metric or signal carrying the most χ² at a fit.
+fn rest_in(
+    obs: &[Observation],
+    sigs: &[Option<CycleSignature>],
+    sims: &[SimCycle],
+    floor: f64,
+    waveforms: bool,
+) -> String {
+    let mut by: Vec<(String, f64)> = Vec::new();
+    let mut add = |k: String, v: f64| match by.iter_mut().find(|(n, _)| *n == k) {
+        Some(e) => e.1 += v,
+        None => by.push((k, v)),
+    };
+    for o in obs {
+        add(
+            o.metric.column().to_string(),
+            o.z2(sims[o.trial].metrics.get(o.metric)),
+        );
+    }
+    if waveforms {
+        for (m, s) in sigs.iter().zip(sims) {
+            let (Some(m), Some(c)) = (m, &s.cycles) else {
+                continue;
+            };
+            for (sig, c2, _) in waveform::chi2(m, c, floor).per_signal {
+                add(format!("the {} cycle", Signal::column(sig)), c2);
+            }
+        }
+    }
+    by.sort_by(|a, b| b.1.total_cmp(&a.1));
+    by.first()
+        .map(|(k, v)| format!("{k} (χ² {v:.0})"))
+        .unwrap_or_default()
+}
+
+/// A diagnosis's look-alike groups, separated with the trials' logs: for each group the
+/// diagnosis could not resolve (`answer.ambiguous`), the separation of its knobs (each
+/// alone, the rest at the file's values). Empty when no trial names a robot log or nothing
+/// is ambiguous: then there is nothing the cycles could add.
+pub fn follow_up(
+    d: &super::diagnose::Diagnosis,
+    set: &TrialSet,
+    lib: &EffectLibrary,
+    opts: &SeparateOptions,
+    progress: &(dyn Fn() + Sync),
+) -> Result<Vec<Separation>, GapError> {
+    if d.answer.ambiguous.is_empty() || set.trials.iter().all(|t| t.trajectory.is_none()) {
+        return Ok(Vec::new());
+    }
+    let conditions = resolve(set)?;
+    let sigs = measured_signatures(set, &conditions, opts.settle_cycles)?;
+    if sigs.iter().all(Option::is_none) {
+        return Ok(Vec::new());
+    }
+    let cache = CycleCache::default();
+    d.answer
+        .ambiguous
+        .iter()
+        .filter(|g| g.len() >= 2)
+        .map(|g| {
+            let o = SeparateOptions {
+                candidates: g.clone(),
+                ..opts.clone()
+            };
+            separate_with(set, &conditions, &sigs, lib, &o, &cache, progress)
+        })
+        .collect()
+}

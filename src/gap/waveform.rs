@@ -1,0 +1,695 @@
+//! Waveform evidence: the cycle of each logged signal over the drive period, reduced to a
+//! few Fourier coefficients per cycle, and the χ² between a measured and a simulated cycle.
+//!
+//! Why Fourier coefficients per cycle: neighbouring samples of a log are strongly
+//! correlated (≈ 200 per cycle, and the gait is smooth), so a χ² over samples would count
+//! the same deviation hundreds of times. A cycle's mean and its first few harmonics carry
+//! the shape (when in the cycle a torque or a loss acts) with nearly uncorrelated errors,
+//! and their spread from cycle to cycle is the measurement's own noise.
+//!
+//! Time alignment is by the drive phase, which the robot's controller knows: a log may carry
+//! it (`drive_phase_cycles`), otherwise it is f·t with t = 0 at the start of the drive (the
+//! simulator's convention: q_d = A·sin(2πft), bang-bang torque positive for phase < ½).
+
+use std::path::Path;
+
+use nalgebra::{DMatrix, DVector};
+use rand::{Rng, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+use serde::Serialize;
+
+use super::error::GapError;
+use crate::sim::TrajectorySample;
+
+/// Harmonics kept per signal (the cycle's mean plus cos/sin of 1..=H times the drive
+/// frequency). The gaits' signals are smooth at the drive period (pitch's main component is
+/// the second harmonic, the hip torque's shape needs the third and fourth: see
+/// reports/gap-example-cycles.svg); more would add coefficients that mostly noise fills.
+pub const HARMONICS: usize = 4;
+/// Bins of the phase-averaged cycle drawn in the figure.
+pub const FIGURE_BINS: usize = 48;
+/// Fewest samples per cycle for a cycle to count (the fit has 2H+2 unknowns).
+const MIN_SAMPLES_PER_CYCLE: usize = 16;
+/// Fewest steady cycles a signature needs (the spread needs several).
+pub const MIN_CYCLES: usize = 3;
+
+/// A logged signal.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Signal {
+    HipAngle,
+    Roll,
+    Pitch,
+    Yaw,
+    HipTorque,
+}
+
+impl Signal {
+    pub const ALL: [Signal; 5] = [
+        Signal::HipAngle,
+        Signal::Roll,
+        Signal::Pitch,
+        Signal::Yaw,
+        Signal::HipTorque,
+    ];
+
+    /// The log's column.
+    pub fn column(self) -> &'static str {
+        match self {
+            Signal::HipAngle => "hip_angle_deg",
+            Signal::Roll => "roll_deg",
+            Signal::Pitch => "pitch_deg",
+            Signal::Yaw => "yaw_deg",
+            Signal::HipTorque => "hip_torque_nm",
+        }
+    }
+
+    pub fn unit(self) -> &'static str {
+        match self {
+            Signal::HipTorque => "N·m",
+            _ => "deg",
+        }
+    }
+
+    /// Yaw's mean is the heading (arbitrary) and it drifts when the walker turns: its cycle
+    /// is fitted with a trend and without its mean.
+    fn has_trend(self) -> bool {
+        self == Signal::Yaw
+    }
+
+    /// Sensor resolution floor of a coefficient, in the signal's unit (an IMU or encoder
+    /// does not resolve a cycle's harmonic below ≈ 0.05°); torque has no absolute floor
+    /// (its scale depends on the robot's size) and relies on the relative one.
+    fn absolute_floor(self) -> f64 {
+        match self {
+            Signal::HipTorque => 0.0,
+            _ => 0.05,
+        }
+    }
+}
+
+/// One sample of a log: what a small walker records (time, hip encoder, IMU attitude, and
+/// optionally the hip torque or current × torque constant, and the drive phase).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct LogSample {
+    pub t_s: f64,
+    pub hip_angle_deg: f64,
+    pub roll_deg: f64,
+    pub pitch_deg: f64,
+    pub yaw_deg: f64,
+    pub hip_torque_nm: Option<f64>,
+    /// Drive phase in cycles since the drive started (None: f·t).
+    pub drive_phase_cycles: Option<f64>,
+}
+
+impl LogSample {
+    pub fn get(&self, s: Signal) -> Option<f64> {
+        match s {
+            Signal::HipAngle => Some(self.hip_angle_deg),
+            Signal::Roll => Some(self.roll_deg),
+            Signal::Pitch => Some(self.pitch_deg),
+            Signal::Yaw => Some(self.yaw_deg),
+            Signal::HipTorque => self.hip_torque_nm,
+        }
+    }
+}
+
+/// A simulated trajectory as a log (the simulator's drive phase is f·t).
+pub fn log_of(samples: &[TrajectorySample]) -> Vec<LogSample> {
+    samples
+        .iter()
+        .map(|s| LogSample {
+            t_s: s.t_s,
+            hip_angle_deg: s.hip_angle_deg,
+            roll_deg: s.roll_deg,
+            pitch_deg: s.pitch_deg,
+            yaw_deg: s.yaw_deg,
+            hip_torque_nm: Some(s.hip_torque_nm),
+            drive_phase_cycles: None,
+        })
+        .collect()
+}
+
+/// Columns a log must have.
+pub const REQUIRED_COLUMNS: [&str; 5] =
+    ["t_s", "hip_angle_deg", "roll_deg", "pitch_deg", "yaw_deg"];
+/// Columns a log may have.
+pub const OPTIONAL_COLUMNS: [&str; 2] = ["hip_torque_nm", "drive_phase_cycles"];
+
+/// True when the CSV file's header has every column of the simulator's full trajectory
+/// format (then the summary metrics can be measured from it too); false for a log with
+/// only the columns a robot records. Errors when the file cannot be read.
+pub fn is_full_trajectory(path: &Path) -> Result<bool, GapError> {
+    let text = std::fs::read_to_string(path).map_err(|source| GapError::Read {
+        path: path.to_path_buf(),
+        source,
+    })?;
+    let header = text
+        .lines()
+        .find(|l| !l.trim_start().starts_with('#'))
+        .unwrap_or("");
+    let cols: Vec<&str> = header.split(',').map(str::trim).collect();
+    Ok([
+        "x_m",
+        "y_m",
+        "z_m",
+        "feet_in_contact",
+        "left_normal_force_n",
+    ]
+    .iter()
+    .all(|c| cols.contains(c)))
+}
+
+/// Reads a log CSV: a header naming at least [`REQUIRED_COLUMNS`] (any order; extra columns
+/// such as the simulator's full trajectory format are ignored), then one sample per line.
+/// Errors name the file, line and column.
+pub fn read_log_csv(path: &Path) -> Result<Vec<LogSample>, GapError> {
+    let text = std::fs::read_to_string(path).map_err(|source| GapError::Read {
+        path: path.to_path_buf(),
+        source,
+    })?;
+    parse_log(&text, &path.display().to_string())
+}
+
+/// [`read_log_csv`] on text (`origin` names it in errors).
+pub fn parse_log(text: &str, origin: &str) -> Result<Vec<LogSample>, GapError> {
+    let bad = |line: usize, column: usize, message: String| GapError::Trials {
+        path: origin.to_string(),
+        line: line as u64,
+        column,
+        message,
+    };
+    let mut lines = text
+        .lines()
+        .enumerate()
+        .filter(|(_, l)| !l.trim_start().starts_with('#'));
+    let header: Vec<&str> = match lines.next() {
+        Some((_, h)) => h.split(',').map(str::trim).collect(),
+        None => return Err(bad(1, 0, "empty log: expected a header line".into())),
+    };
+    let find = |name: &str| header.iter().position(|h| *h == name);
+    let mut required = [0usize; 5];
+    for (k, name) in REQUIRED_COLUMNS.iter().enumerate() {
+        required[k] = find(name).ok_or_else(|| {
+            bad(
+                1,
+                0,
+                format!(
+                    "missing column `{name}` (a log needs {}; optional: {})",
+                    REQUIRED_COLUMNS.join(", "),
+                    OPTIONAL_COLUMNS.join(", ")
+                ),
+            )
+        })?;
+    }
+    let torque = find("hip_torque_nm");
+    let phase = find("drive_phase_cycles");
+    let mut out: Vec<LogSample> = Vec::new();
+    for (i, line) in lines {
+        if line.trim().is_empty() {
+            continue;
+        }
+        let cells: Vec<&str> = line.split(',').map(str::trim).collect();
+        let number = |col: usize, name: &str| -> Result<f64, GapError> {
+            let cell = cells
+                .get(col)
+                .ok_or_else(|| bad(i + 1, col + 1, format!("column `{name}`: missing cell")))?;
+            let v = cell.parse::<f64>().map_err(|_| {
+                bad(
+                    i + 1,
+                    col + 1,
+                    format!("column `{name}`: `{cell}` is not a number"),
+                )
+            })?;
+            if !v.is_finite() {
+                return Err(bad(
+                    i + 1,
+                    col + 1,
+                    format!("column `{name}`: {v} is not finite"),
+                ));
+            }
+            Ok(v)
+        };
+        let optional = |col: Option<usize>, name: &str| -> Result<Option<f64>, GapError> {
+            match col {
+                Some(c) if cells.get(c).is_some_and(|s| !s.is_empty()) => {
+                    Ok(Some(number(c, name)?))
+                }
+                _ => Ok(None),
+            }
+        };
+        let s = LogSample {
+            t_s: number(required[0], "t_s")?,
+            hip_angle_deg: number(required[1], "hip_angle_deg")?,
+            roll_deg: number(required[2], "roll_deg")?,
+            pitch_deg: number(required[3], "pitch_deg")?,
+            yaw_deg: number(required[4], "yaw_deg")?,
+            hip_torque_nm: optional(torque, "hip_torque_nm")?,
+            drive_phase_cycles: optional(phase, "drive_phase_cycles")?,
+        };
+        if let Some(p) = out.last() {
+            if s.t_s <= p.t_s {
+                return Err(bad(
+                    i + 1,
+                    required[0] + 1,
+                    format!("column `t_s`: time {} does not increase", s.t_s),
+                ));
+            }
+            if let (Some(a), Some(b)) = (p.drive_phase_cycles, s.drive_phase_cycles)
+                && b < a
+            {
+                return Err(bad(
+                    i + 1,
+                    phase.map_or(0, |c| c + 1),
+                    format!(
+                        "column `drive_phase_cycles`: {b} decreases (the phase counts cycles \
+                         since the drive started, it does not wrap)"
+                    ),
+                ));
+            }
+        }
+        out.push(s);
+    }
+    Ok(out)
+}
+
+/// A log as CSV text with the columns a real robot's log provides (time, hip angle,
+/// attitude, hip torque when known); the caller writes it (atomically, in the CLI).
+pub fn log_csv_text(log: &[LogSample]) -> String {
+    use std::fmt::Write as _;
+    let mut text = String::from("t_s,hip_angle_deg,roll_deg,pitch_deg,yaw_deg,hip_torque_nm\n");
+    for s in log {
+        let torque = s.hip_torque_nm.map(|v| v.to_string()).unwrap_or_default();
+        // Writing to a String cannot fail.
+        let _ = writeln!(
+            text,
+            "{},{},{},{},{},{}",
+            s.t_s, s.hip_angle_deg, s.roll_deg, s.pitch_deg, s.yaw_deg, torque
+        );
+    }
+    text
+}
+
+/// Sensor noise added to a simulated log to make a synthetic measurement.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SensorNoise {
+    /// sd of each angle sample [deg] (an IMU's attitude estimate, an encoder's quantisation).
+    pub angle_deg: f64,
+    /// sd of each torque sample, as a fraction of the log's largest |torque| (a current sense).
+    pub torque_fraction: f64,
+}
+
+impl Default for SensorNoise {
+    fn default() -> Self {
+        SensorNoise {
+            angle_deg: 0.3,
+            torque_fraction: 0.03,
+        }
+    }
+}
+
+/// The log plus white Gaussian sensor noise, deterministic in `seed`.
+pub fn add_sensor_noise(log: &[LogSample], noise: SensorNoise, seed: u64) -> Vec<LogSample> {
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    let peak = log
+        .iter()
+        .filter_map(|s| s.hip_torque_nm)
+        .fold(0.0f64, |a, b| a.max(b.abs()));
+    let torque_sd = noise.torque_fraction * peak;
+    log.iter()
+        .map(|s| {
+            let mut n = || normal(&mut rng);
+            LogSample {
+                hip_angle_deg: s.hip_angle_deg + noise.angle_deg * n(),
+                roll_deg: s.roll_deg + noise.angle_deg * n(),
+                pitch_deg: s.pitch_deg + noise.angle_deg * n(),
+                yaw_deg: s.yaw_deg + noise.angle_deg * n(),
+                hip_torque_nm: s.hip_torque_nm.map(|v| v + torque_sd * n()),
+                ..*s
+            }
+        })
+        .collect()
+}
+
+/// A standard normal draw by Box–Muller (as `synth` does; rand_distr is not a dependency).
+fn normal(rng: &mut ChaCha8Rng) -> f64 {
+    let u1: f64 = 1.0 - rng.random::<f64>();
+    let u2: f64 = rng.random::<f64>();
+    (-2.0 * u1.ln()).sqrt() * (std::f64::consts::TAU * u2).cos()
+}
+
+/// The steady cycle of one signal.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct SignalCycle {
+    pub signal: Signal,
+    /// Mean over cycles of [a₀, a₁, b₁, …, a_H, b_H]: y(φ) ≈ a₀ + Σ a_k cos 2πkφ + b_k sin 2πkφ
+    /// (a₀ is NaN for yaw, whose mean is the arbitrary heading).
+    pub coefficients: Vec<f64>,
+    /// Cycle-to-cycle sd of each coefficient (the sd of one cycle's value).
+    pub spread: Vec<f64>,
+    /// RMS of the mean cycle about its mean (its size: the relative floor's unit).
+    pub rms: f64,
+    /// The mean cycle rebuilt from the coefficients at [`FIGURE_BINS`] phases.
+    pub cycle: Vec<f64>,
+}
+
+/// The steady cycles of a log.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct CycleSignature {
+    pub drive_frequency_hz: f64,
+    /// Whole drive cycles used.
+    pub cycles: usize,
+    pub signals: Vec<SignalCycle>,
+}
+
+impl CycleSignature {
+    pub fn signal(&self, s: Signal) -> Option<&SignalCycle> {
+        self.signals.iter().find(|c| c.signal == s)
+    }
+}
+
+/// The steady cycle of every signal the log has: cycles `settle_cycles` and later (whole
+/// cycles only), each fitted by least squares with the mean and [`HARMONICS`] harmonics
+/// (plus a trend for yaw); their mean and spread. Errors when fewer than [`MIN_CYCLES`]
+/// steady cycles have enough samples.
+pub fn signature(
+    log: &[LogSample],
+    drive_frequency_hz: f64,
+    settle_cycles: usize,
+) -> Result<CycleSignature, String> {
+    if !(drive_frequency_hz > 0.0 && drive_frequency_hz.is_finite()) {
+        return Err(format!(
+            "drive frequency {drive_frequency_hz} Hz: must be a positive number"
+        ));
+    }
+    let phase = |s: &LogSample| s.drive_phase_cycles.unwrap_or(s.t_s * drive_frequency_hz);
+    // Group samples by whole cycle.
+    let mut by_cycle: std::collections::BTreeMap<i64, Vec<&LogSample>> = Default::default();
+    for s in log {
+        let p = phase(s);
+        if p.is_finite() && p >= settle_cycles as f64 {
+            by_cycle.entry(p.floor() as i64).or_default().push(s);
+        }
+    }
+    // The last cycle may be cut short: keep cycles whose samples span most of the period.
+    let cycles: Vec<(i64, Vec<&LogSample>)> = by_cycle
+        .into_iter()
+        .filter(|(j, v)| {
+            v.len() >= MIN_SAMPLES_PER_CYCLE && {
+                let first = phase(v[0]) - *j as f64;
+                let last = phase(v[v.len() - 1]) - *j as f64;
+                first < 0.1 && last > 0.9
+            }
+        })
+        .collect();
+    if cycles.len() < MIN_CYCLES {
+        return Err(format!(
+            "{} steady drive cycle(s) after the first {settle_cycles} with at least \
+             {MIN_SAMPLES_PER_CYCLE} samples each; at least {MIN_CYCLES} are needed",
+            cycles.len()
+        ));
+    }
+    let mut signals = Vec::new();
+    for signal in Signal::ALL {
+        if log.iter().any(|s| s.get(signal).is_none()) {
+            continue;
+        }
+        let per_cycle: Vec<Vec<f64>> = cycles
+            .iter()
+            .map(|(j, v)| {
+                let pts: Vec<(f64, f64)> = v
+                    .iter()
+                    .filter_map(|s| s.get(signal).map(|y| (phase(s) - *j as f64, y)))
+                    .collect();
+                fit_cycle(&pts, signal.has_trend())
+            })
+            .collect::<Option<Vec<_>>>()
+            .ok_or_else(|| format!("{}: a cycle's harmonic fit is singular", signal.column()))?;
+        let n = per_cycle.len() as f64;
+        let k = per_cycle[0].len();
+        let mean: Vec<f64> = (0..k)
+            .map(|c| per_cycle.iter().map(|v| v[c]).sum::<f64>() / n)
+            .collect();
+        let spread: Vec<f64> = (0..k)
+            .map(|c| {
+                let ss: f64 = per_cycle.iter().map(|v| (v[c] - mean[c]).powi(2)).sum();
+                (ss / (n - 1.0)).sqrt()
+            })
+            .collect();
+        let rms = (mean[1..].iter().map(|a| a * a).sum::<f64>() / 2.0).sqrt();
+        let cycle = (0..FIGURE_BINS)
+            .map(|b| evaluate(&mean, (b as f64 + 0.5) / FIGURE_BINS as f64))
+            .collect();
+        let mut coefficients = mean;
+        let mut spread = spread;
+        if signal.has_trend() {
+            coefficients[0] = f64::NAN;
+            spread[0] = f64::NAN;
+        }
+        signals.push(SignalCycle {
+            signal,
+            coefficients,
+            spread,
+            rms,
+            cycle,
+        });
+    }
+    Ok(CycleSignature {
+        drive_frequency_hz,
+        cycles: cycles.len(),
+        signals,
+    })
+}
+
+/// Least-squares fit of one cycle's points (phase within the cycle, value) by
+/// [a₀, a₁, b₁, …, a_H, b_H] (plus a trend column whose coefficient is dropped).
+fn fit_cycle(pts: &[(f64, f64)], trend: bool) -> Option<Vec<f64>> {
+    let k = 1 + 2 * HARMONICS;
+    let cols = k + usize::from(trend);
+    let a = DMatrix::from_fn(pts.len(), cols, |r, c| {
+        let phi = pts[r].0;
+        if c == 0 {
+            1.0
+        } else if c < k {
+            let h = c.div_ceil(2) as f64;
+            let x = std::f64::consts::TAU * h * phi;
+            if c % 2 == 1 { x.cos() } else { x.sin() }
+        } else {
+            phi - 0.5
+        }
+    });
+    let y = DVector::from_iterator(pts.len(), pts.iter().map(|p| p.1));
+    let x = a.svd(true, true).solve(&y, 1e-12).ok()?;
+    Some(x.iter().take(k).copied().collect())
+}
+
+/// The cycle of coefficients at phase `phi` (a NaN mean counts as 0).
+pub fn evaluate(coef: &[f64], phi: f64) -> f64 {
+    let mut y = if coef[0].is_finite() { coef[0] } else { 0.0 };
+    for h in 1..=HARMONICS {
+        let x = std::f64::consts::TAU * h as f64 * phi;
+        y += coef[2 * h - 1] * x.cos() + coef[2 * h] * x.sin();
+    }
+    y
+}
+
+/// The χ² of a simulated cycle against a measured one, per signal.
+#[derive(Clone, Debug, Default, PartialEq, Serialize)]
+pub struct WaveformChi2 {
+    pub chi2: f64,
+    /// Coefficients compared.
+    pub n: usize,
+    /// (signal, χ², coefficients) for each signal both sides have.
+    pub per_signal: Vec<(Signal, f64, usize)>,
+}
+
+/// z = (simulated − measured)/σ per coefficient, with σ² the sum of the measured mean's sd²
+/// (spread²/n), the simulated mean's sd² and the floor², where floor = max(relative_floor ·
+/// the measured signal's RMS, the sensor floor). The floor is the model error a cycle is allowed: without
+/// it a few hundred cycles of a real log would resolve differences no simulator can be
+/// trusted to (the same floor stands between the summaries' sd and their exactness).
+pub fn chi2(
+    measured: &CycleSignature,
+    simulated: &CycleSignature,
+    relative_floor: f64,
+) -> WaveformChi2 {
+    let mut out = WaveformChi2::default();
+    for m in &measured.signals {
+        let Some(s) = simulated.signal(m.signal) else {
+            continue;
+        };
+        let floor = (relative_floor * m.rms).max(m.signal.absolute_floor());
+        let (nm, ns) = (measured.cycles as f64, simulated.cycles as f64);
+        let mut c2 = 0.0;
+        let mut n = 0;
+        for c in 0..m.coefficients.len() {
+            let (x, y) = (s.coefficients[c], m.coefficients[c]);
+            if !(x.is_finite() && y.is_finite()) {
+                continue;
+            }
+            let var = m.spread[c].powi(2) / nm + s.spread[c].powi(2) / ns + floor * floor;
+            if var > 0.0 {
+                c2 += (x - y).powi(2) / var;
+                n += 1;
+            }
+        }
+        out.chi2 += c2;
+        out.n += n;
+        out.per_signal.push((m.signal, c2, n));
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn log_of_fn(f: impl Fn(f64) -> f64, hz: f64, cycles: f64, per_cycle: usize) -> Vec<LogSample> {
+        let n = (cycles * per_cycle as f64) as usize;
+        (0..n)
+            .map(|i| {
+                let t = i as f64 / (per_cycle as f64 * hz);
+                LogSample {
+                    t_s: t,
+                    hip_angle_deg: f(t),
+                    roll_deg: 0.5 * f(t),
+                    pitch_deg: 1.0,
+                    yaw_deg: 3.0 * t + (std::f64::consts::TAU * hz * t).sin(),
+                    hip_torque_nm: None,
+                    drive_phase_cycles: None,
+                }
+            })
+            .collect()
+    }
+
+    /// A known waveform: y = 2 + 10 sin 2πft + 3 cos 4πft − 1 sin 6πft gives a₀ = 2,
+    /// b₁ = 10, a₂ = 3, b₃ = −1 and nothing else, exactly; yaw's linear drift is removed and
+    /// its sin term kept; a constant has RMS 0.
+    #[test]
+    fn harmonics_of_a_known_waveform() {
+        let hz = 1.7;
+        let tau = std::f64::consts::TAU;
+        let f = |t: f64| {
+            2.0 + 10.0 * (tau * hz * t).sin() + 3.0 * (2.0 * tau * hz * t).cos()
+                - (3.0 * tau * hz * t).sin()
+        };
+        let log = log_of_fn(f, hz, 12.3, 150);
+        let sig = signature(&log, hz, 2).expect("signature");
+        assert_eq!(sig.cycles, 10, "cycles 2..=11; the cut 12th is dropped");
+        let hip = sig.signal(Signal::HipAngle).expect("hip");
+        let want = [2.0, 0.0, 10.0, 3.0, 0.0, 0.0, -1.0, 0.0, 0.0];
+        for (c, w) in hip.coefficients.iter().zip(want) {
+            assert!((c - w).abs() < 1e-9, "{:?} vs {want:?}", hip.coefficients);
+        }
+        // RMS of the AC part: √((10² + 3² + 1²)/2).
+        assert!((hip.rms - (110.0f64 / 2.0).sqrt()).abs() < 1e-9);
+        let yaw = sig.signal(Signal::Yaw).expect("yaw");
+        assert!(yaw.coefficients[0].is_nan());
+        assert!(
+            (yaw.coefficients[2] - 1.0).abs() < 1e-9,
+            "{:?}",
+            yaw.coefficients
+        );
+        let pitch = sig.signal(Signal::Pitch).expect("pitch");
+        assert!((pitch.coefficients[0] - 1.0).abs() < 1e-12 && pitch.rms < 1e-9);
+        assert!(sig.signal(Signal::HipTorque).is_none(), "no torque column");
+        // The rebuilt cycle at phase ¼: 2 + 10 − 3 + 1 = 10.
+        assert!((evaluate(&hip.coefficients, 0.25) - 10.0).abs() < 1e-9);
+    }
+
+    /// The drive phase column wins over f·t: a log whose clock starts 0.25 cycle late but
+    /// carries the phase gives the same coefficients as the aligned one.
+    #[test]
+    fn drive_phase_column_aligns_a_late_clock() {
+        let hz = 2.0;
+        let tau = std::f64::consts::TAU;
+        let f = |t: f64| 5.0 * (tau * hz * t).sin();
+        let aligned = log_of_fn(f, hz, 10.0, 100);
+        let late: Vec<LogSample> = aligned
+            .iter()
+            .map(|s| LogSample {
+                drive_phase_cycles: Some(s.t_s * hz),
+                t_s: s.t_s + 0.125,
+                ..*s
+            })
+            .collect();
+        let a = signature(&aligned, hz, 1).expect("a");
+        let b = signature(&late, hz, 1).expect("b");
+        let (ha, hb) = (
+            a.signal(Signal::HipAngle).unwrap(),
+            b.signal(Signal::HipAngle).unwrap(),
+        );
+        for (x, y) in ha.coefficients.iter().zip(&hb.coefficients) {
+            assert!((x - y).abs() < 1e-9);
+        }
+    }
+
+    /// White noise of sd σ on N samples per cycle gives a harmonic coefficient a spread of
+    /// σ·√(2/N) (least squares on an orthogonal basis); checked over 60 cycles to 25 %.
+    #[test]
+    fn spread_of_white_noise_matches_least_squares_theory() {
+        let hz = 1.0;
+        let clean = log_of_fn(|t| (std::f64::consts::TAU * t).sin(), hz, 63.0, 200);
+        let noisy = add_sensor_noise(
+            &clean,
+            SensorNoise {
+                angle_deg: 0.4,
+                torque_fraction: 0.0,
+            },
+            7,
+        );
+        let sig = signature(&noisy, hz, 2).expect("sig");
+        let hip = sig.signal(Signal::HipAngle).unwrap();
+        let want = 0.4 * (2.0f64 / 200.0).sqrt();
+        for c in 1..hip.spread.len() {
+            assert!(
+                (hip.spread[c] / want - 1.0).abs() < 0.25,
+                "coefficient {c}: spread {} vs {want}",
+                hip.spread[c]
+            );
+        }
+        // A signature against itself is χ² 0; against a copy shifted by 2 floors in one
+        // coefficient, 4.
+        let same = chi2(&sig, &sig, 0.05);
+        assert_eq!(same.chi2, 0.0);
+        let mut shifted = sig.clone();
+        // The floor: 5 % of the RMS (0.035° here) or the sensor floor 0.05°, the larger.
+        let floor = (0.05 * hip.rms).max(0.05);
+        let var = 2.0 * hip.spread[2].powi(2) / sig.cycles as f64 + floor * floor;
+        shifted.signals[0].coefficients[2] += 2.0 * var.sqrt();
+        let c = chi2(&sig, &shifted, 0.05);
+        assert!((c.chi2 - 4.0).abs() < 1e-9, "{}", c.chi2);
+    }
+
+    #[test]
+    fn too_few_cycles_and_bad_logs_are_clear_errors() {
+        let log = log_of_fn(|t| t.sin(), 1.0, 4.0, 50);
+        let e = signature(&log, 1.0, 2).expect_err("2 cycles");
+        assert!(e.contains("at least 3"), "{e}");
+        let e = parse_log("t_s,roll_deg,pitch_deg,yaw_deg\n0,0,0,0\n", "x.csv").expect_err("hip");
+        assert!(
+            e.to_string().contains("missing column `hip_angle_deg`"),
+            "{e}"
+        );
+        let e = parse_log(
+            "t_s,hip_angle_deg,roll_deg,pitch_deg,yaw_deg\n0,1,2,3,4\n0.01,1,two,3,4\n",
+            "x.csv",
+        )
+        .expect_err("number");
+        assert!(e.to_string().starts_with("x.csv:3:3:"), "{e}");
+        let e = parse_log(
+            "t_s,hip_angle_deg,roll_deg,pitch_deg,yaw_deg\n0.1,1,2,3,4\n0.1,1,2,3,4\n",
+            "x.csv",
+        )
+        .expect_err("time");
+        assert!(e.to_string().contains("does not increase"), "{e}");
+        let ok = parse_log(
+            "# a comment\nyaw_deg,t_s,pitch_deg,roll_deg,hip_angle_deg,extra\n4,0,3,2,1,x\n",
+            "x.csv",
+        )
+        .expect("any order, extra columns");
+        assert_eq!(ok[0].hip_angle_deg, 1.0);
+        assert_eq!(ok[0].yaw_deg, 4.0);
+        assert!(ok[0].hip_torque_nm.is_none());
+    }
+}
