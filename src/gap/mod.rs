@@ -15,8 +15,14 @@
 //!   refinement with walks, held-out χ², profiles, consistency across groups).
 //! * [`select`]: forward selection with the call rules; [`diagnose`]: the answer;
 //!   [`locate`]: where the gap lies; [`identify`]: detection and identification thresholds.
-//! * [`synth`]: "real" trials simulated with withheld effects or wrong parameters plus noise.
-//! * [`benchmark`]: the diagnosis on cases of known cause, inside and outside its library.
+//! * [`waveform`]: a robot's log (time, hip angle, attitude, torque) reduced to the Fourier
+//!   coefficients of its steady cycle, and their χ² against a simulated cycle;
+//!   [`separate`]: look-alike candidates ranked on summaries and on summaries + cycles;
+//!   [`suggest`]: the next trials that best separate the two leading candidates.
+//! * [`synth`]: "real" trials simulated with withheld effects or wrong parameters plus noise
+//!   (and robot logs).
+//! * [`benchmark`]: the diagnosis on cases of known cause, inside and outside its library;
+//!   [`waveform_bench`]: what the logged cycles buy on the look-alike pairs.
 //!
 //! Depends on [`crate::sim`] (the simulator) and [`crate::regression`] (distributions) only.
 
