@@ -4,9 +4,12 @@
 # test conditions) with 3 % noise; three more trials either suggested by `survey gap suggest` or at
 # the design's own drives (0.97, 1, 1.03×); both sets separated on the summaries alone.
 # Run from the repository root after `cargo build --release`: tools/gap-suggest-check.sh [seeds]
+# Another truth: EFFECT=soft_ground M=1e8 RIVAL=hip_backlash tools/gap-suggest-check.sh 10
 set -euo pipefail
 S="$(pwd)/${SURVEY:-target/release/survey}"
+E="${EFFECT:-hip_coulomb_friction}"
 M="${M:-0.006}"
+RIVAL="${RIVAL:-hip_viscous_damping}"
 N="${1:-10}"
 work="$(mktemp -d)"
 trap 'rm -rf "$work"' EXIT
@@ -19,14 +22,14 @@ d-f1x,mugatu-two-uncertain.toml,0.153,1.24,default repeat
 d-f1.03x,mugatu-two-uncertain.toml,0.153,1.2772,default repeat
 CSV
 verdict() {
-  "$S" gap separate --trials "$1" --candidates hip_coulomb_friction,hip_viscous_damping 2>/dev/null \
+  "$S" gap separate --trials "$1" --candidates "$E,$RIVAL" 2>/dev/null \
     | grep -m1 '^Answer' | sed -e 's/^Answer: \*\*\([^*]*\)\*\*.*/\1/'
 }
 for seed in $(seq 1 "$N"); do
-  "$S" gap synth --conditions conditions-6.csv --effect "hip_coulomb_friction=$M" --noise 0.03 --seed "$seed" --out base.csv 2>/dev/null
-  "$S" gap suggest --trials base.csv --candidates hip_coulomb_friction,hip_viscous_damping --budget 3 --out next.csv >/dev/null 2>&1
-  "$S" gap synth --conditions next.csv --effect "hip_coulomb_friction=$M" --noise 0.03 --seed $((seed + 1000)) --out nextm.csv 2>/dev/null
-  "$S" gap synth --conditions default3.csv --effect "hip_coulomb_friction=$M" --noise 0.03 --seed $((seed + 1000)) --out defm.csv 2>/dev/null
+  "$S" gap synth --conditions conditions-6.csv --effect "$E=$M" --noise 0.03 --seed "$seed" --out base.csv 2>/dev/null
+  "$S" gap suggest --trials base.csv --candidates "$E,$RIVAL" --budget 3 --out next.csv >/dev/null 2>&1
+  "$S" gap synth --conditions next.csv --effect "$E=$M" --noise 0.03 --seed $((seed + 1000)) --out nextm.csv 2>/dev/null
+  "$S" gap synth --conditions default3.csv --effect "$E=$M" --noise 0.03 --seed $((seed + 1000)) --out defm.csv 2>/dev/null
   (cat base.csv; tail -n +2 nextm.csv) > withnext.csv
   (cat base.csv; tail -n +2 defm.csv) > withdef.csv
   echo "seed $seed | suggested: $(verdict withnext.csv) | default: $(verdict withdef.csv)"

@@ -40,6 +40,20 @@ pub const POOL: Pool = Pool {
     slopes_deg: &[-2.0, 0.0, 2.0],
 };
 
+/// Step of a leader's value for the smoothness check, as a fraction of its range in its
+/// coordinate (effects: ln magnitude, so ≈ ±10 % for a range of two decades).
+const SMOOTHNESS_STEP: f64 = 0.02;
+/// Largest bend (m₋ + m₊ − 2m₀, in the new trial's sds) a metric may show over the step:
+/// beyond it the gait changes character within the candidate's own uncertainty.
+const SMOOTHNESS_Z: f64 = 2.0;
+
+fn fell_count(walks: &[[SimCycle; 3]]) -> usize {
+    walks
+        .iter()
+        .filter(|w| w.iter().any(|x| x.metrics.fell))
+        .count()
+}
+
 /// Largest expected z² one metric (or one signal's cycle) of one trial may contribute: a
 /// 5-sd difference already decides; beyond it the two models walk qualitatively different
 /// gaits there (a bifurcation), where the simulator's own resolution is least trusted, so a
@@ -78,9 +92,12 @@ pub struct Suggestion {
     /// The two leading explanations and their fitted values (SI).
     pub leading: Vec<(String, f64)>,
     pub budget: usize,
-    /// Pool conditions tried, and those where all three models walk.
+    /// Pool conditions tried, and those offered: all three models walk and the leaders'
+    /// gaits are smooth there.
     pub pool: usize,
     pub walkable: usize,
+    /// Conditions left out because a leader's metrics bend sharply there (or a step falls).
+    pub knife_edge: usize,
     pub relative_sd: f64,
     /// Best first.
     pub suggested: Vec<Suggested>,
@@ -152,6 +169,45 @@ pub fn suggest(
             Ok(r)
         })
         .collect::<Result<_, GapError>>()?;
+    // Smoothness: each leader a step below and above its fitted value; a condition where
+    // the metrics bend more than SMOOTHNESS_Z sds over that step (or a step falls) is a
+    // knife-edge gait: a trial there cannot be fitted reliably, whatever it separates.
+    let smooth: Vec<bool> = pool
+        .par_iter()
+        .zip(&walks)
+        .map(|(c, w)| {
+            if w.iter().any(|x| x.metrics.fell) {
+                return Ok(false);
+            }
+            for (lead, (lo, hi)) in [(1usize, (2usize, 3usize)), (2, (4, 5))] {
+                let minus = simulate_cycles(c, lib, &settings[lo], settle)?;
+                let plus = simulate_cycles(c, lib, &settings[hi], settle)?;
+                if minus.metrics.fell || plus.metrics.fell {
+                    return Ok(false);
+                }
+                for m in Metric::SIMULATED {
+                    let (a, b, x) = (
+                        minus.metrics.get(m),
+                        plus.metrics.get(m),
+                        w[lead].metrics.get(m),
+                    );
+                    if a.is_finite() && b.is_finite() && x.is_finite() && x != 0.0 {
+                        let bend = (a + b - 2.0 * x).abs() / (relative_sd * x.abs());
+                        if bend > SMOOTHNESS_Z {
+                            return Ok(false);
+                        }
+                    }
+                }
+            }
+            progress();
+            Ok(true)
+        })
+        .collect::<Result<_, GapError>>()?;
+    let knife_edge = walks
+        .iter()
+        .zip(&smooth)
+        .filter(|(w, ok)| !**ok && !w.iter().any(|x| x.metrics.fell))
+        .count();
     let score = |c: &Condition, w: &[SimCycle; 3]| -> Option<Suggested> {
         if w.iter().any(|x| x.metrics.fell) {
             return None;
@@ -190,7 +246,9 @@ pub fn suggest(
     let mut scored: Vec<Suggested> = pool
         .iter()
         .zip(&walks)
-        .filter_map(|(c, w)| score(c, w))
+        .zip(&smooth)
+        .filter(|(_, ok)| **ok)
+        .filter_map(|((c, w), _)| score(c, w))
         .collect();
     let walkable = scored.len();
     let with_logs = sep.trials_with_logs > 0;
@@ -219,14 +277,17 @@ pub fn suggest(
         budget: opts.budget,
         pool: pool.len(),
         walkable,
+        knife_edge,
         relative_sd,
         suggested: scored,
         default_condition,
-        walks: sep.walks + 3 * pool.len(),
+        walks: sep.walks + 3 * pool.len() + 4 * (pool.len() - fell_count(&walks)),
     })
 }
 
 /// The settings of the two leading candidates at their fitted values.
+/// The settings of the two leading candidates at their fitted values, and each a step
+/// [`SMOOTHNESS_STEP`] (of its range, in its coordinate) below and above: [A, B, A−, A+, B−, B+].
 fn separate_settings(
     conditions: &[Condition],
     lib: &EffectLibrary,
@@ -238,18 +299,26 @@ fn separate_settings(
         origin: "designs".into(),
         source: e,
     })?;
-    leading
-        .iter()
-        .map(|(label, si)| {
-            let k = knobs
-                .index_of(label)
-                .ok_or_else(|| GapError::Invalid(format!("unknown knob {label}")))?;
-            let knob = &knobs.list[k];
+    let mut at = Vec::new();
+    let mut steps = Vec::new();
+    for (label, si) in leading {
+        let k = knobs
+            .index_of(label)
+            .ok_or_else(|| GapError::Invalid(format!("unknown knob {label}")))?;
+        let knob = &knobs.list[k];
+        let x = knob.coordinate(si / knob.si_per_value);
+        let h = SMOOTHNESS_STEP * (knob.hi - knob.lo);
+        let setting = |x: f64| {
             let mut point = knobs.nominal_point();
-            point[k] = Some(knob.coordinate(si / knob.si_per_value));
-            Ok(knobs.setting(lib, &point))
-        })
-        .collect()
+            point[k] = Some(x);
+            knobs.setting(lib, &point)
+        };
+        at.push(setting(x));
+        steps.push(setting(x - h));
+        steps.push(setting(x + h));
+    }
+    at.extend(steps);
+    Ok(at)
 }
 
 /// The index of the robot's own condition: the most common (design, size) of the trials.

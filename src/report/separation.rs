@@ -342,11 +342,14 @@ pub fn suggestion_md(s: &Suggestion) -> String {
     let _ = writeln!(
         o,
         "Leading explanations (fitted to the trials): {}. Pool: {} conditions of {} at the robot's \
-         size, {} where the nominal and both walk; summaries scored at {} % relative sd. {} walks.\n",
+         size, {} where the nominal and both walk, of which {} left out as knife-edge (a leader's \
+         metrics bend by more than 2 sd within ±2 % of its range); summaries scored at {} % \
+         relative sd. {} walks.\n",
         lead.join(" vs "),
         s.pool,
         s.design,
-        s.walkable,
+        s.walkable + s.knife_edge,
+        s.knife_edge,
         sig(100.0 * s.relative_sd),
         s.walks
     );
