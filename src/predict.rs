@@ -100,6 +100,39 @@ pub struct Prediction {
     pub extrapolation: Option<String>,
 }
 
+impl Prediction {
+    /// The masses a torque requirement is evaluated at (label, kg, prediction interval):
+    /// the class fit's mean with its interval, and the scaled reference under m ∝ L² and
+    /// m ∝ L³ when there is one.
+    pub fn reference_masses(&self) -> Vec<(String, f64, Option<[f64; 2]>)> {
+        let mut masses = Vec::new();
+        if let Some(q) = self.quantities.iter().find(|q| q.quantity == Var::Mass) {
+            masses.push((
+                format!(
+                    "{} fit (mean, {:.0} % prediction interval)",
+                    self.class.as_str(),
+                    100.0 * self.confidence
+                ),
+                q.mean,
+                Some(q.prediction_interval),
+            ));
+        }
+        if let Some(r) = &self.scaled_reference {
+            masses.push((
+                format!("{} scaled, m ∝ L²", r.reference.name),
+                r.mass_l2_kg,
+                None,
+            ));
+            masses.push((
+                format!("{} scaled, m ∝ L³", r.reference.name),
+                r.mass_l3_kg,
+                None,
+            ));
+        }
+        masses
+    }
+}
+
 /// What the designer asks.
 #[derive(Debug, Clone, Default)]
 pub struct PredictRequest {

@@ -159,24 +159,6 @@ fn fit_json(
     })
 }
 
-/// Table III points: a file, or the bundled copy (as the CLI).
-fn load_table3_points(path: Option<&Path>) -> Res<Vec<Table3Point>> {
-    Ok(match path {
-        Some(p) => robot_survey::study::sweep::read_points::<Table3Point>(p)?.1,
-        None => table3::bundled_points()?,
-    })
-}
-
-/// The motor catalogue: dataset/motors when present, else the bundled one (as the CLI).
-fn load_motors() -> Res<robot_survey::motors::MotorCatalogue> {
-    use robot_survey::motors::MotorCatalogue;
-    Ok(if Path::new("dataset/motors").is_dir() {
-        MotorCatalogue::load(Path::new("dataset/motors"))?
-    } else {
-        MotorCatalogue::bundled()?
-    })
-}
-
 /// `survey predict --format json` (with the required hip torque and actuators when the
 /// reference is a walker design and a leg length is given).
 #[pyfunction]
@@ -263,36 +245,9 @@ fn torque_need(
     if !(torque_margin.is_finite() && torque_margin > 0.0) {
         anyhow::bail!("--torque-margin must be > 0, got {torque_margin}");
     }
-    let points = load_table3_points(points_file)?;
-    let motors = load_motors().ok();
-    let mut masses = Vec::new();
-    if let Some(q) = pred
-        .quantities
-        .iter()
-        .find(|q| q.quantity == robot_survey::survey::Var::Mass)
-    {
-        masses.push((
-            format!(
-                "{} fit (mean, {:.0} % prediction interval)",
-                pred.class.as_str(),
-                100.0 * pred.confidence
-            ),
-            q.mean,
-            Some(q.prediction_interval),
-        ));
-    }
-    if let Some(r) = &pred.scaled_reference {
-        masses.push((
-            format!("{} scaled, m ∝ L²", r.reference.name),
-            r.mass_l2_kg,
-            None,
-        ));
-        masses.push((
-            format!("{} scaled, m ∝ L³", r.reference.name),
-            r.mass_l3_kg,
-            None,
-        ));
-    }
+    let points = table3::points(points_file)?;
+    let motors = robot_survey::motors::MotorCatalogue::locate(None).ok();
+    let masses = pred.reference_masses();
     Ok(robot_survey::study::torque_need::torque_need(
         &points,
         design,
@@ -675,7 +630,15 @@ fn gap_synth_csv(
     detached(py, || {
         let lib = EffectLibrary::bundled()?;
         let design = Design::resolve(&design_name)?;
-        let settings = gap::library::parse_effect_args(&lib, &design, &effects)?;
+        let (opts, command) = gap::synth::SynthOptions::from_args(
+            &lib,
+            &design,
+            &design_name,
+            &effects,
+            &set,
+            noise,
+            seed,
+        )?;
         let conditions = match (&conditions_path, &conditions_text) {
             (None, None) => None,
             (p, t) => Some(trials_of(
@@ -684,34 +647,6 @@ fn gap_synth_csv(
                 &origin,
                 base_dir.as_deref().unwrap_or(Path::new(".")),
             )?),
-        };
-        let mut command = format!(
-            "synthetic: survey gap synth --design {design_name} --noise {noise} --seed {seed}"
-        );
-        for e in &effects {
-            command.push_str(&format!(" --effect {e}"));
-        }
-        let mut params = Vec::new();
-        for arg in &set {
-            let (path, value) = arg
-                .split_once('=')
-                .ok_or_else(|| anyhow::anyhow!("--set {arg}: expected PATH=VALUE"))?;
-            let value: f64 = value
-                .trim()
-                .parse()
-                .map_err(|_| anyhow::anyhow!("--set {arg}: {value:?} is not a number"))?;
-            design
-                .with_value(path.trim(), value)
-                .map_err(|e| anyhow::anyhow!("--set {arg}: {e}"))?;
-            params.push((path.trim().to_string(), value));
-            command.push_str(&format!(" --set {arg}"));
-        }
-        let opts = gap::synth::SynthOptions {
-            design: design_name.clone(),
-            effects: settings,
-            params,
-            noise,
-            seed,
         };
         let out = gap::synth::synthesize(&lib, &opts, conditions, &command, &|| {})?;
         Ok(out.to_csv())

@@ -201,36 +201,9 @@ fn torque_need(
     if !(a.torque_margin.is_finite() && a.torque_margin > 0.0) {
         anyhow::bail!("--torque-margin must be > 0, got {}", a.torque_margin);
     }
-    let points = super::study::load_table3_points(a.table3.as_deref())?;
-    let motors = super::study::load_motors(None).ok();
-    let mut masses = Vec::new();
-    if let Some(q) = pred
-        .quantities
-        .iter()
-        .find(|q| q.quantity == robot_survey::survey::Var::Mass)
-    {
-        masses.push((
-            format!(
-                "{} fit (mean, {:.0} % prediction interval)",
-                pred.class.as_str(),
-                100.0 * pred.confidence
-            ),
-            q.mean,
-            Some(q.prediction_interval),
-        ));
-    }
-    if let Some(r) = &pred.scaled_reference {
-        masses.push((
-            format!("{} scaled, m ∝ L²", r.reference.name),
-            r.mass_l2_kg,
-            None,
-        ));
-        masses.push((
-            format!("{} scaled, m ∝ L³", r.reference.name),
-            r.mass_l3_kg,
-            None,
-        ));
-    }
+    let points = robot_survey::study::table3::points(a.table3.as_deref())?;
+    let motors = robot_survey::motors::MotorCatalogue::locate(None).ok();
+    let masses = pred.reference_masses();
     Ok(Some(robot_survey::study::torque_need::torque_need(
         &points,
         design,

@@ -351,43 +351,15 @@ fn bar(len: u64, what: &str) -> indicatif::ProgressBar {
 fn synth(a: &SynthArgs) -> anyhow::Result<ExitCode> {
     let lib = EffectLibrary::bundled()?;
     let design = Design::resolve(&a.design)?;
-    let effects = gap::library::parse_effect_args(&lib, &design, &a.effects)?;
+    let (opts, mut command) = gap::synth::SynthOptions::from_args(
+        &lib, &design, &a.design, &a.effects, &a.set, a.noise, a.seed,
+    )?;
     let conditions = match &a.conditions {
         Some(p) => Some(TrialSet::read(p)?),
         None => None,
     };
     let n = conditions.as_ref().map(|c| c.trials.len()).unwrap_or(12) as u64;
     let pb = bar(n, "simulating the trials");
-    let mut command = format!(
-        "synthetic: survey gap synth --design {} --noise {} --seed {}",
-        a.design, a.noise, a.seed
-    );
-    for e in &a.effects {
-        command.push_str(&format!(" --effect {e}"));
-    }
-    let mut params = Vec::new();
-    for arg in &a.set {
-        let (path, value) = arg
-            .split_once('=')
-            .ok_or_else(|| anyhow::anyhow!("--set {arg}: expected PATH=VALUE"))?;
-        let value: f64 = value
-            .trim()
-            .parse()
-            .map_err(|_| anyhow::anyhow!("--set {arg}: {value:?} is not a number"))?;
-        // Checked now, naming the argument: the path exists and the value is valid.
-        design
-            .with_value(path.trim(), value)
-            .map_err(|e| anyhow::anyhow!("--set {arg}: {e}"))?;
-        params.push((path.trim().to_string(), value));
-        command.push_str(&format!(" --set {arg}"));
-    }
-    let opts = gap::synth::SynthOptions {
-        design: a.design.clone(),
-        effects,
-        params,
-        noise: a.noise,
-        seed: a.seed,
-    };
     let Some(dir) = &a.logs else {
         let set = gap::synth::synthesize(&lib, &opts, conditions, &command, &|| pb.inc(1))?;
         pb.finish_and_clear();

@@ -446,27 +446,9 @@ pub struct TorqueCheckArgs {
 }
 
 /// Table III points: a file, or the bundled copy.
-pub fn load_table3_points(path: Option<&Path>) -> anyhow::Result<Vec<Table3Point>> {
-    Ok(match path {
-        Some(p) => sweep::read_points::<Table3Point>(p)?.1,
-        None => table3::bundled_points()?,
-    })
-}
-
-pub fn load_motors(dir: Option<&Path>) -> anyhow::Result<robot_survey::motors::MotorCatalogue> {
-    use robot_survey::motors::MotorCatalogue;
-    Ok(match dir {
-        Some(d) => MotorCatalogue::load(d)?,
-        None if Path::new("dataset/motors").is_dir() => {
-            MotorCatalogue::load(Path::new("dataset/motors"))?
-        }
-        None => MotorCatalogue::bundled()?,
-    })
-}
-
 pub fn torque_check(a: &TorqueCheckArgs) -> anyhow::Result<ExitCode> {
     let design = Design::resolve(&a.design)?;
-    let points = load_table3_points(a.points.as_deref())?;
+    let points = table3::points(a.points.as_deref())?;
     let rows = table3::rows_from_points(&points);
     let row = rows
         .iter()
@@ -480,7 +462,7 @@ pub fn torque_check(a: &TorqueCheckArgs) -> anyhow::Result<ExitCode> {
                 a.design
             )
         })?;
-    let catalogue = load_motors(a.motors.as_deref())?;
+    let catalogue = robot_survey::motors::MotorCatalogue::locate(a.motors.as_deref())?;
     let mass_at = |l: f64| {
         design
             .scaled(l, a.mass_law, a.contact)

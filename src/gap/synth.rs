@@ -142,6 +142,54 @@ pub struct SynthOptions {
     pub seed: u64,
 }
 
+impl SynthOptions {
+    /// The options of `survey gap synth` from its arguments — effects as `NAME=VALUE` or
+    /// `NAME.PARAM=VALUE`, wrong parameters as `PATH=VALUE` (checked on `design` now, so an
+    /// error names the argument) — and the command line every row records as its source.
+    /// `design_arg` is the design as the user named it (a bundled name or a path).
+    pub fn from_args(
+        lib: &EffectLibrary,
+        design: &Design,
+        design_arg: &str,
+        effects: &[String],
+        set: &[String],
+        noise: f64,
+        seed: u64,
+    ) -> Result<(SynthOptions, String), GapError> {
+        let settings = super::library::parse_effect_args(lib, design, effects)?;
+        let mut command = format!(
+            "synthetic: survey gap synth --design {design_arg} --noise {noise} --seed {seed}"
+        );
+        for e in effects {
+            command.push_str(&format!(" --effect {e}"));
+        }
+        let mut params = Vec::new();
+        for arg in set {
+            let (path, value) = arg
+                .split_once('=')
+                .ok_or_else(|| GapError::Invalid(format!("--set {arg}: expected PATH=VALUE")))?;
+            let value: f64 = value.trim().parse().map_err(|_| {
+                GapError::Invalid(format!("--set {arg}: {value:?} is not a number"))
+            })?;
+            design
+                .with_value(path.trim(), value)
+                .map_err(|e| GapError::Invalid(format!("--set {arg}: {e}")))?;
+            params.push((path.trim().to_string(), value));
+            command.push_str(&format!(" --set {arg}"));
+        }
+        Ok((
+            SynthOptions {
+                design: design_arg.to_string(),
+                effects: settings,
+                params,
+                noise,
+                seed,
+            },
+            command,
+        ))
+    }
+}
+
 /// Simulates `conditions` (None: the design's defaults) with the withheld effects and
 /// noise; `command` is recorded as every row's source.
 pub fn synthesize(

@@ -423,6 +423,17 @@ impl MotorCatalogue {
         })
     }
 
+    /// The catalogue a command uses: `dir` when given; else `./dataset/motors` when the
+    /// working directory is a checkout (a contributor's edits count at once); else the
+    /// bundled one.
+    pub fn locate(dir: Option<&Path>) -> Result<Self, MotorError> {
+        match dir {
+            Some(d) => Self::load(d),
+            None if Path::new("dataset/motors").is_dir() => Self::load(Path::new("dataset/motors")),
+            None => Self::bundled(),
+        }
+    }
+
     /// The catalogue compiled into the binary (`dataset/motors/`).
     pub fn bundled() -> Result<Self, MotorError> {
         let dir = crate::dataset::bundled_dir("motors").ok_or(MotorError::NotBundled)?;

@@ -531,6 +531,16 @@ pub fn rows_from_points(points: &[Table3Point]) -> Vec<Table3Row> {
         .collect()
 }
 
+/// Table III points from a points file (`survey sim table3 --points FILE`), or the bundled
+/// copy when `path` is None (what `survey predict`, `survey torque-check` and the Python
+/// package read).
+pub fn points(path: Option<&std::path::Path>) -> Result<Vec<Table3Point>, StudyError> {
+    match path {
+        Some(p) => Ok(crate::checkpoint::read_points::<Table3Point>(p)?.1),
+        None => bundled_points(),
+    }
+}
+
 /// The project's Table III points (`reports/table3.points.csv`, made by
 /// `survey sim table3 --out reports/`), compiled in for `survey predict` and
 /// `survey torque-check`.
