@@ -382,7 +382,7 @@ fn synth(a: &SynthArgs) -> anyhow::Result<ExitCode> {
         a.sensor_noise_deg,
         a.sensor_noise_torque
     ));
-    let sensor = gap::waveform::SensorNoise {
+    let sensor = gap::synth::SensorNoise {
         angle_deg: a.sensor_noise_deg,
         torque_fraction: a.sensor_noise_torque,
     };

@@ -131,6 +131,57 @@ pub fn add_noise(
     out
 }
 
+/// Sensor noise added to a simulated log to make a synthetic measurement.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SensorNoise {
+    /// sd of each angle sample [deg] (an IMU's attitude estimate, an encoder's quantisation).
+    pub angle_deg: f64,
+    /// sd of each torque sample, as a fraction of the log's largest |torque| (a current sense).
+    pub torque_fraction: f64,
+}
+
+impl Default for SensorNoise {
+    fn default() -> Self {
+        SensorNoise {
+            angle_deg: 0.3,
+            torque_fraction: 0.03,
+        }
+    }
+}
+
+/// The sensor-noise seed of trial `i`'s log under a measurement seed: distinct per trial, so
+/// two trials of one synthetic set never share a noise sequence.
+pub fn log_seed(seed: u64, i: usize) -> u64 {
+    seed ^ 0x9E37_79B9_7F4A_7C15u64.wrapping_mul(i as u64 + 1)
+}
+
+/// The log plus white Gaussian sensor noise, deterministic in `seed`.
+pub fn add_sensor_noise(
+    log: &[super::waveform::LogSample],
+    noise: SensorNoise,
+    seed: u64,
+) -> Vec<super::waveform::LogSample> {
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    let peak = log
+        .iter()
+        .filter_map(|s| s.hip_torque_nm)
+        .fold(0.0f64, |a, b| a.max(b.abs()));
+    let torque_sd = noise.torque_fraction * peak;
+    log.iter()
+        .map(|s| {
+            let mut n = || normal(&mut rng);
+            super::waveform::LogSample {
+                hip_angle_deg: s.hip_angle_deg + noise.angle_deg * n(),
+                roll_deg: s.roll_deg + noise.angle_deg * n(),
+                pitch_deg: s.pitch_deg + noise.angle_deg * n(),
+                yaw_deg: s.yaw_deg + noise.angle_deg * n(),
+                hip_torque_nm: s.hip_torque_nm.map(|v| v + torque_sd * n()),
+                ..*s
+            }
+        })
+        .collect()
+}
+
 /// What `survey gap synth` produces.
 pub struct SynthOptions {
     pub design: String,
@@ -279,7 +330,7 @@ pub fn synthesize_logs(
     opts: &SynthOptions,
     conditions: Option<TrialSet>,
     command: &str,
-    sensor: super::waveform::SensorNoise,
+    sensor: SensorNoise,
     progress: &(dyn Fn() + Sync),
 ) -> Result<(TrialSet, Vec<Vec<super::waveform::LogSample>>), GapError> {
     use rayon::prelude::*;
@@ -301,8 +352,7 @@ pub fn synthesize_logs(
         .iter()
         .enumerate()
         .map(|(i, (_, tr))| {
-            let seed = opts.seed ^ (0x9E37_79B9_7F4A_7C15u64.wrapping_mul(i as u64 + 1));
-            super::waveform::add_sensor_noise(&super::waveform::log_of(tr), sensor, seed)
+            add_sensor_noise(&super::waveform::log_of(tr), sensor, log_seed(opts.seed, i))
         })
         .collect();
     Ok((

@@ -14,8 +14,6 @@
 use std::path::Path;
 
 use nalgebra::{DMatrix, DVector};
-use rand::{Rng, SeedableRng};
-use rand_chacha::ChaCha8Rng;
 use serde::Serialize;
 
 use super::error::GapError;
@@ -140,14 +138,21 @@ pub const OPTIONAL_COLUMNS: [&str; 2] = ["hip_torque_nm", "drive_phase_cycles"];
 /// format (then the summary metrics can be measured from it too); false for a log with
 /// only the columns a robot records. Errors when the file cannot be read.
 pub fn is_full_trajectory(path: &Path) -> Result<bool, GapError> {
-    let text = std::fs::read_to_string(path).map_err(|source| GapError::Read {
+    use std::io::BufRead;
+    let read = |source| GapError::Read {
         path: path.to_path_buf(),
         source,
-    })?;
-    let header = text
-        .lines()
-        .find(|l| !l.trim_start().starts_with('#'))
-        .unwrap_or("");
+    };
+    // The header only: the log itself is read once, by the caller that needs its samples.
+    let file = std::fs::File::open(path).map_err(read)?;
+    let mut header = String::new();
+    for line in std::io::BufReader::new(file).lines() {
+        let line = line.map_err(read)?;
+        if !line.trim_start().starts_with('#') {
+            header = line;
+            break;
+        }
+    }
     let cols: Vec<&str> = header.split(',').map(str::trim).collect();
     Ok([
         "x_m",
@@ -288,54 +293,6 @@ pub fn log_csv_text(log: &[LogSample]) -> String {
         );
     }
     text
-}
-
-/// Sensor noise added to a simulated log to make a synthetic measurement.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct SensorNoise {
-    /// sd of each angle sample [deg] (an IMU's attitude estimate, an encoder's quantisation).
-    pub angle_deg: f64,
-    /// sd of each torque sample, as a fraction of the log's largest |torque| (a current sense).
-    pub torque_fraction: f64,
-}
-
-impl Default for SensorNoise {
-    fn default() -> Self {
-        SensorNoise {
-            angle_deg: 0.3,
-            torque_fraction: 0.03,
-        }
-    }
-}
-
-/// The log plus white Gaussian sensor noise, deterministic in `seed`.
-pub fn add_sensor_noise(log: &[LogSample], noise: SensorNoise, seed: u64) -> Vec<LogSample> {
-    let mut rng = ChaCha8Rng::seed_from_u64(seed);
-    let peak = log
-        .iter()
-        .filter_map(|s| s.hip_torque_nm)
-        .fold(0.0f64, |a, b| a.max(b.abs()));
-    let torque_sd = noise.torque_fraction * peak;
-    log.iter()
-        .map(|s| {
-            let mut n = || normal(&mut rng);
-            LogSample {
-                hip_angle_deg: s.hip_angle_deg + noise.angle_deg * n(),
-                roll_deg: s.roll_deg + noise.angle_deg * n(),
-                pitch_deg: s.pitch_deg + noise.angle_deg * n(),
-                yaw_deg: s.yaw_deg + noise.angle_deg * n(),
-                hip_torque_nm: s.hip_torque_nm.map(|v| v + torque_sd * n()),
-                ..*s
-            }
-        })
-        .collect()
-}
-
-/// A standard normal draw by Box–Muller (as `synth` does; rand_distr is not a dependency).
-fn normal(rng: &mut ChaCha8Rng) -> f64 {
-    let u1: f64 = 1.0 - rng.random::<f64>();
-    let u2: f64 = rng.random::<f64>();
-    (-2.0 * u1.ln()).sqrt() * (std::f64::consts::TAU * u2).cos()
 }
 
 /// The steady cycle of one signal.
@@ -630,9 +587,9 @@ mod tests {
     fn spread_of_white_noise_matches_least_squares_theory() {
         let hz = 1.0;
         let clean = log_of_fn(|t| (std::f64::consts::TAU * t).sin(), hz, 63.0, 200);
-        let noisy = add_sensor_noise(
+        let noisy = crate::gap::synth::add_sensor_noise(
             &clean,
-            SensorNoise {
+            crate::gap::synth::SensorNoise {
                 angle_deg: 0.4,
                 torque_fraction: 0.0,
             },

@@ -14,9 +14,9 @@ use super::knob::ModelSetting;
 use super::library::EffectLibrary;
 use super::separate::{CycleCache, Evidence, SeparateOptions, Verdict, separate_with};
 use super::simulate::{Condition, SimMetrics, resolve};
-use super::synth::{add_noise, default_conditions};
+use super::synth::{SensorNoise, add_noise, add_sensor_noise, default_conditions, log_seed};
 use super::trials::TrialSet;
-use super::waveform::{self, CycleSignature, SensorNoise};
+use super::waveform::{self, CycleSignature};
 use crate::sim::TrajectorySample;
 
 #[derive(Clone, Debug)]
@@ -260,11 +260,7 @@ fn measurement(
             if m.fell {
                 return Ok(None);
             }
-            let log = waveform::add_sensor_noise(
-                &waveform::log_of(tr),
-                opts.sensor,
-                h ^ (0x9E37_79B9_7F4A_7C15u64.wrapping_mul(i as u64 + 1)),
-            );
+            let log = add_sensor_noise(&waveform::log_of(tr), opts.sensor, log_seed(h, i));
             Ok(
                 waveform::signature(&log, c.drive_frequency_hz()?, opts.separate.settle_cycles)
                     .ok(),
