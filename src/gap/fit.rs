@@ -728,26 +728,8 @@ impl<'a> FitContext<'a> {
                     sims,
                 ))
             };
-            let g = (5f64.sqrt() - 1.0) / 2.0;
-            let (mut lo, mut hi) = (a, b);
-            let (mut c, mut d) = (hi - g * (hi - lo), lo + g * (hi - lo));
-            let (mut fc, mut fd) = (eval(c)?, eval(d)?);
-            for _ in 0..10 {
-                if fc.0 < fd.0 {
-                    hi = d;
-                    d = c;
-                    fd = fc;
-                    c = hi - g * (hi - lo);
-                    fc = eval(c)?;
-                } else {
-                    lo = c;
-                    c = d;
-                    fc = fd;
-                    d = lo + g * (hi - lo);
-                    fd = eval(d)?;
-                }
-            }
-            let (chi2, point, sims) = if fc.0 < fd.0 { fc } else { fd };
+            let (_, chi2, (point, sims)) =
+                super::solver::golden_section(a, b, 10, |x| eval(x).map(|(c, p, s)| (c, (p, s))))?;
             if chi2 < best.chi2 - 1e-9 {
                 let mut unit = best.unit.clone();
                 unit[pos] = knob.to_unit(point[k].unwrap_or(x0));

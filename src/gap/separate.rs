@@ -384,39 +384,18 @@ pub fn separate_with(
                 s: grid[j].1,
                 w: grid[j].2,
             };
-            // Golden section between the best node's neighbours, one new walk set per step.
-            let (mut a, mut b) = (
+            // Golden section between the best node's neighbours on walks: refine_steps + 1
+            // walk sets (two open the bracket), kept only where it beats the node.
+            let (a, b) = (
                 nodes[j.saturating_sub(1)],
                 nodes[(j + 1).min(nodes.len() - 1)],
             );
-            let g = (5f64.sqrt() - 1.0) / 2.0;
-            let mut c = b - g * (b - a);
-            let mut d = a + g * (b - a);
-            let mut fc = eval(c)?;
-            let mut fd = eval(d)?;
-            for step in 0..opts.refine_steps {
-                for (x, f) in [(c, &fc), (d, &fd)] {
-                    if cost(f.1, f.2) < cost(best.s, best.w) {
-                        best = Best {
-                            x,
-                            sims: f.0.clone(),
-                            s: f.1,
-                            w: f.2,
-                        };
-                    }
-                }
-                if step + 1 == opts.refine_steps {
-                    break;
-                }
-                if cost(fc.1, fc.2) < cost(fd.1, fd.2) {
-                    (b, d, fd) = (d, c, fc);
-                    c = b - g * (b - a);
-                    fc = eval(c)?;
-                } else {
-                    (a, c, fc) = (c, d, fd);
-                    d = a + g * (b - a);
-                    fd = eval(d)?;
-                }
+            let (x, c, (sims, s, w)) =
+                super::solver::golden_section(a, b, opts.refine_steps.saturating_sub(1), |x| {
+                    eval(x).map(|(sims, s, w)| (cost(s, w), (sims, s, w)))
+                })?;
+            if c < cost(best.s, best.w) {
+                best = Best { x, sims, s, w };
             }
             Ok(best)
         };
