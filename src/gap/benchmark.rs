@@ -1030,6 +1030,45 @@ fn covered(row: &CaseRow, knob: &dyn Fn(&str) -> bool, v: f64) -> Option<bool> {
     })
 }
 
+/// A confusion matrix of `cases`: rows by `truth`, columns by what was `named`, both in
+/// sorted order.
+fn confusion(
+    title: String,
+    cases: &[&CaseRow],
+    truth: impl Fn(&CaseRow) -> String,
+    named: impl Fn(&CaseRow) -> String,
+) -> Confusion {
+    let mut rows: Vec<String> = Vec::new();
+    let mut columns: Vec<String> = Vec::new();
+    for r in cases {
+        let (t, c) = (truth(r), named(r));
+        if !rows.contains(&t) {
+            rows.push(t);
+        }
+        if !columns.contains(&c) {
+            columns.push(c);
+        }
+    }
+    rows.sort();
+    columns.sort();
+    let mut counts = vec![vec![0; columns.len()]; rows.len()];
+    for r in cases {
+        let (t, c) = (truth(r), named(r));
+        if let (Some(i), Some(j)) = (
+            rows.iter().position(|x| *x == t),
+            columns.iter().position(|x| *x == c),
+        ) {
+            counts[i][j] += 1;
+        }
+    }
+    Confusion {
+        title,
+        rows,
+        columns,
+        counts,
+    }
+}
+
 /// The scores of the rows (any subset: one shard's, or merged).
 pub fn summarize(
     rows: &[CaseRow],
@@ -1320,8 +1359,6 @@ pub fn summarize(
             if cases.iter().all(|r| r.kind == "null") {
                 continue;
             }
-            let mut row_labels: Vec<String> = Vec::new();
-            let mut col_labels: Vec<String> = Vec::new();
             let first = |r: &CaseRow| -> String {
                 split(&r.named_effects)
                     .first()
@@ -1333,45 +1370,22 @@ pub fn summarize(
                     })
                     .unwrap_or_else(|| "none".into())
             };
-            for r in &cases {
-                let t = parse_pairs(&r.truth_effects)
+            let truth = |r: &CaseRow| -> String {
+                parse_pairs(&r.truth_effects)
                     .first()
                     .map(|(e, _)| e.clone())
-                    .unwrap_or_else(|| "null".into());
-                if !row_labels.contains(&t) {
-                    row_labels.push(t);
-                }
-                let c = first(r);
-                if !col_labels.contains(&c) {
-                    col_labels.push(c);
-                }
-            }
-            row_labels.sort();
-            col_labels.sort();
-            let mut counts = vec![vec![0; col_labels.len()]; row_labels.len()];
-            for r in &cases {
-                let t = parse_pairs(&r.truth_effects)
-                    .first()
-                    .map(|(e, _)| e.clone())
-                    .unwrap_or_else(|| "null".into());
-                let (Some(i), Some(j)) = (
-                    row_labels.iter().position(|x| *x == t),
-                    col_labels.iter().position(|x| *x == first(r)),
-                ) else {
-                    continue;
-                };
-                counts[i][j] += 1;
-            }
-            confusions.push(Confusion {
-                title: format!(
+                    .unwrap_or_else(|| "null".into())
+            };
+            confusions.push(confusion(
+                format!(
                     "single effects and nulls at {:.0} % noise{}",
                     noise * 100.0,
                     if calibrate { "" } else { ", calibration off" }
                 ),
-                rows: row_labels,
-                columns: col_labels,
-                counts,
-            });
+                &cases,
+                truth,
+                first,
+            ));
         }
     }
     {
@@ -1380,8 +1394,6 @@ pub fn summarize(
             .filter(|r| r.suite == "main" && r.kind == "parameter")
             .collect();
         if !cases.is_empty() {
-            let mut row_labels: Vec<String> = Vec::new();
-            let mut col_labels: Vec<String> = Vec::new();
             let label = |r: &CaseRow| -> String {
                 let mut v: Vec<String> = split(&r.named_params)
                     .iter()
@@ -1394,32 +1406,12 @@ pub fn summarize(
                     v.join(" + ")
                 }
             };
-            for r in &cases {
-                if !row_labels.contains(&r.truth_params) {
-                    row_labels.push(r.truth_params.clone());
-                }
-                let c = label(r);
-                if !col_labels.contains(&c) {
-                    col_labels.push(c);
-                }
-            }
-            row_labels.sort();
-            col_labels.sort();
-            let mut counts = vec![vec![0; col_labels.len()]; row_labels.len()];
-            for r in &cases {
-                if let (Some(i), Some(j)) = (
-                    row_labels.iter().position(|x| *x == r.truth_params),
-                    col_labels.iter().position(|x| *x == label(r)),
-                ) {
-                    counts[i][j] += 1;
-                }
-            }
-            confusions.push(Confusion {
-                title: "nominal-parameter errors (main suite): what was named".into(),
-                rows: row_labels,
-                columns: col_labels,
-                counts,
-            });
+            confusions.push(confusion(
+                "nominal-parameter errors (main suite): what was named".into(),
+                &cases,
+                |r| r.truth_params.clone(),
+                label,
+            ));
         }
     }
     BenchmarkSummary {
