@@ -283,3 +283,29 @@ fn diagnose_separates_its_look_alike_group_with_the_logs() {
         "{follow}"
     );
 }
+
+/// Another engine's data, no effect added: four Drake walks of the reference Mugatu
+/// (`tests/data/gap/drake-walks.csv`, the golden trajectories). The gap there is the
+/// engines' friction model (reports/drake-crosscheck.md), a cause in no library; so for
+/// the look-alike pairs neither the summaries nor the cycles may name a candidate.
+#[test]
+fn separate_names_nothing_on_drake_walks_without_an_added_effect() {
+    let trials = repo().join("tests/data/gap/drake-walks.csv");
+    for pair in [
+        "hip_coulomb_friction,hip_viscous_damping",
+        "actuation_latency,hip_backlash",
+    ] {
+        let r = separate(trials.to_str().expect("utf-8"), pair);
+        assert_eq!(
+            r.len(),
+            2,
+            "{pair}: both rankings (the trajectories are logs)"
+        );
+        for (evidence, kind, v) in &r {
+            assert_ne!(
+                kind, "named",
+                "{pair}, {evidence}: {v} named on Drake's data"
+            );
+        }
+    }
+}
