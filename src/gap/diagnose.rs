@@ -518,17 +518,7 @@ pub fn diagnose_conditions(
         ..opts.select.clone()
     };
     let groups = groupings(conditions);
-    let labels: Vec<String> = set
-        .trials
-        .iter()
-        .map(|t| {
-            if t.label.is_empty() {
-                format!("line {}", t.line)
-            } else {
-                t.label.clone()
-            }
-        })
-        .collect();
+    let labels: Vec<String> = set.trials.iter().map(|t| t.name()).collect();
     let selection = select(&ctx, &sel_opts, &nominal, &groups, &labels)?;
     timing.select_s = t1.elapsed().as_secs_f64();
 
@@ -928,15 +918,7 @@ fn rest_of(ctx: &FitContext<'_>, fit: &Fit, alpha: f64, set: &TrialSet) -> Optio
             .iter()
             .take(3)
             .filter(|(_, v)| *v > 4.0)
-            .map(|(t, v)| {
-                let tr = &set.trials[*t];
-                let label = if tr.label.is_empty() {
-                    format!("line {}", tr.line)
-                } else {
-                    tr.label.clone()
-                };
-                format!("{label} (|z| {:.1})", v.sqrt())
-            })
+            .map(|(t, v)| format!("{} (|z| {:.1})", set.trials[*t].name(), v.sqrt()))
             .collect();
         parts.push(format!(
             "{} (RMS z {:.1}{}{})",
@@ -1092,11 +1074,7 @@ fn residuals(
         };
         out.push(Residual {
             trial: o.trial,
-            label: if t.label.is_empty() {
-                format!("line {}", t.line)
-            } else {
-                t.label.clone()
-            },
+            label: t.name(),
             design: t.design.clone(),
             leg_length_m: c.leg_length_m,
             frequency_hz: c.drive_frequency_hz()?,

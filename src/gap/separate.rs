@@ -528,7 +528,7 @@ pub fn separate_with(
         for (i, m) in sigs.iter().enumerate() {
             let Some(m) = m else { continue };
             cycles.push(TrialCycles {
-                trial: trial_name(set, i),
+                trial: set.trials[i].name(),
                 measured: m.clone(),
                 nominal: nominal[i].cycles.clone(),
                 best: fits[bi][1].sims[i].cycles.clone(),
@@ -574,15 +574,6 @@ fn check(opts: &SeparateOptions) -> Result<(), GapError> {
         )));
     }
     Ok(())
-}
-
-fn trial_name(set: &TrialSet, i: usize) -> String {
-    let t = &set.trials[i];
-    if t.label.is_empty() {
-        format!("line {}", t.line)
-    } else {
-        t.label.clone()
-    }
 }
 
 /// The metric or signal carrying the most χ² at a fit.

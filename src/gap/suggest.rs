@@ -18,6 +18,7 @@ use super::separate::{
     simulate_cycles,
 };
 use super::simulate::{Condition, resolve};
+use super::synth::round_sig;
 use super::trials::{Metric, Trial, TrialSet};
 use super::waveform;
 use crate::sim::design::ControlSpec;
@@ -415,9 +416,9 @@ pub fn as_trials(s: &Suggestion) -> Vec<Trial> {
         .map(|x| {
             let mut t = Trial::condition(&s.design, x.leg_length_m);
             t.label = x.label.clone();
-            t.frequency_hz = Some(round6(x.frequency_hz));
-            t.amplitude_deg = x.amplitude_deg.map(round6);
-            t.mass_kg = Some(round6(x.mass_kg));
+            t.frequency_hz = Some(round_sig(x.frequency_hz, 6));
+            t.amplitude_deg = x.amplitude_deg.map(|a| round_sig(a, 6));
+            t.mass_kg = Some(round_sig(x.mass_kg, 6));
             t.slope_deg = Some(x.slope_deg);
             t.source = format!(
                 "suggested by survey gap suggest: separates {} from {}",
@@ -427,13 +428,4 @@ pub fn as_trials(s: &Suggestion) -> Vec<Trial> {
             t
         })
         .collect()
-}
-
-/// Six significant digits (what a lab sets; no float noise in the CSV).
-fn round6(x: f64) -> f64 {
-    if x == 0.0 || !x.is_finite() {
-        return x;
-    }
-    let p = 10f64.powi(5 - x.abs().log10().floor() as i32);
-    (x * p).round() / p
 }

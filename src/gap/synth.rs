@@ -77,7 +77,8 @@ pub fn default_conditions(design_name: &str) -> Result<Vec<Trial>, GapError> {
     Ok(out)
 }
 
-fn round_sig(x: f64, digits: i32) -> f64 {
+/// `x` to `digits` significant digits (what a lab sets; no float noise in a CSV).
+pub(crate) fn round_sig(x: f64, digits: i32) -> f64 {
     if x == 0.0 || !x.is_finite() {
         return x;
     }

@@ -145,6 +145,15 @@ impl Trial {
     pub fn measured(&self, m: Metric) -> Option<Measurement> {
         self.measured[m.index()]
     }
+
+    /// How reports name the trial: its label, or its line in the file.
+    pub fn name(&self) -> String {
+        if self.label.is_empty() {
+            format!("line {}", self.line)
+        } else {
+            self.label.clone()
+        }
+    }
 }
 
 /// The trials of one file.
