@@ -9,6 +9,7 @@ mod gap;
 mod gap_open;
 mod gap_waveform;
 mod live_dataset;
+mod readme;
 mod load_fuzz;
 mod min_torque;
 mod motors;
