@@ -93,7 +93,10 @@ fn readme_numbers() {
     let (Some(b), Some(e)) = (readme.find(BEGIN), readme.find(END)) else {
         panic!("README.md lacks the generated block's markers:\n{BEGIN}\n…\n{END}");
     };
-    assert!(b < e, "README.md: the generated block's END marker comes before BEGIN");
+    assert!(
+        b < e,
+        "README.md: the generated block's END marker comes before BEGIN"
+    );
     let current = &readme[b + BEGIN.len()..e];
     let want = format!("\n{}", generated_block());
     if current == want {
