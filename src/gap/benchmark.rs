@@ -391,9 +391,6 @@ pub fn plan(
         .iter()
         .map(|e| e.name.clone())
         .collect();
-    let mut suites = Vec::new();
-    let mut cases = Vec::new();
-    let mut thr_table: BTreeMap<String, Vec<(String, Option<f64>)>> = BTreeMap::new();
 
     progress("default conditions");
     let main = Suite::new(
@@ -404,333 +401,24 @@ pub fn plan(
             trials: default_conditions(&opts.design)?,
         },
     )?;
-    let nominal = main
-        .cache
-        .get(&main.conditions, lib, &ModelSetting::nominal(), &|| {})?;
-    let mut noise_for_thr: Vec<f64> = opts.noise_levels.clone();
-    noise_for_thr.push(opts.pair_noise);
-    noise_for_thr.sort_by(f64::total_cmp);
-    noise_for_thr.dedup();
-    let mut thr: BTreeMap<String, BTreeMap<String, f64>> = BTreeMap::new();
-    let mut thr_off: BTreeMap<String, BTreeMap<String, f64>> = BTreeMap::new();
-    for &noise in &noise_for_thr {
-        progress(&format!("thresholds at {} % noise", noise * 100.0));
-        if opts.calibration_off_noise == Some(noise) {
-            let off = thresholds(
-                &main.base,
-                &main.conditions,
-                &nominal,
-                lib,
-                noise,
-                &opts.effects,
-                false,
-                &main.cache,
-            )?;
-            thr_off.insert(
-                format!("{noise}"),
-                off.iter()
-                    .filter_map(|i| i.identification_threshold.map(|t| (i.effect.clone(), t)))
-                    .collect(),
-            );
-        }
-        let mut ids = thresholds(
-            &main.base,
-            &main.conditions,
-            &nominal,
-            lib,
-            noise,
-            &opts.effects,
-            true,
-            &main.cache,
-        )?;
-        // Effects the design calibrates as a parameter have no effect knob: their threshold
-        // against the other effects (calibration off).
-        let missing: Vec<String> = effect_names
-            .iter()
-            .filter(|e| !ids.iter().any(|i| &i.effect == *e))
-            .cloned()
-            .collect();
-        if !missing.is_empty() {
-            let off = thresholds(
-                &main.base,
-                &main.conditions,
-                &nominal,
-                lib,
-                noise,
-                &missing,
-                false,
-                &main.cache,
-            )?;
-            ids.extend(off);
-            ids.sort_by(|a, b| a.effect.cmp(&b.effect));
-        }
-        let key = format!("{noise}");
-        // An effect not identifiable within its range has no threshold: no case of it is
-        // made (the report lists it), since "k times the threshold" does not exist.
-        thr_table.insert(
-            key.clone(),
-            ids.iter()
-                .map(|i| (i.effect.clone(), i.identification_threshold))
-                .collect(),
-        );
-        thr.insert(
-            key,
-            ids.iter()
-                .filter_map(|i| i.identification_threshold.map(|t| (i.effect.clone(), t)))
-                .collect(),
-        );
-    }
-    let thr_of = |noise: f64, e: &str| -> Option<f64> {
-        thr.get(&format!("{noise}")).and_then(|m| m.get(e)).copied()
+    let thr = Thresholds::of_main(lib, opts, &main, &effect_names, progress)?;
+    let mut planner = Planner {
+        lib,
+        opts,
+        design: &design,
+        effect_names: &effect_names,
+        thr: &thr,
+        cases: Vec::new(),
     };
-    let thr_off_of = |noise: f64, e: &str| -> Option<f64> {
-        thr_off
-            .get(&format!("{noise}"))
-            .and_then(|m| m.get(e))
-            .copied()
-    };
-    let sim_case = |suite: &str,
-                    kind: &str,
-                    noise: f64,
-                    seed: u64,
-                    calibrate: bool,
-                    multiple: Option<f64>,
-                    params: Vec<(String, f64)>,
-                    effects: Vec<(String, f64)>| {
-        let truth = Truth::Sim { params, effects };
-        let key = format!(
-            "{suite}/{kind}/{}/{}/n{noise}/s{seed}{}",
-            match &truth {
-                Truth::Sim { effects, .. } => pairs(effects),
-                Truth::Drake { .. } => String::new(),
-            },
-            match &truth {
-                Truth::Sim { params, .. } => pairs(params),
-                Truth::Drake { .. } => String::new(),
-            },
-            if calibrate { "" } else { "/nocal" }
-        );
-        CaseSpec {
-            key,
-            suite: suite.into(),
-            kind: kind.into(),
-            noise,
-            seed,
-            calibrate,
-            multiple,
-            truth,
-        }
-    };
-    // Nulls.
-    for &noise in &opts.noise_levels {
-        for seed in 0..opts.null_cases {
-            cases.push(sim_case(
-                "main",
-                "null",
-                noise,
-                seed,
-                true,
-                None,
-                vec![],
-                vec![],
-            ));
-        }
-    }
-    // Single effects.
-    let singles = |noise: f64, calibrate: bool, cases: &mut Vec<CaseSpec>| {
-        for e in &effect_names {
-            let t = if calibrate {
-                thr_of(noise, e)
-            } else {
-                thr_off_of(noise, e)
-            };
-            let Some(t) = t else { continue };
-            for &k in &opts.multiples {
-                let mag = magnitude_at(lib, &design, e, t, k);
-                for seed in 0..opts.seeds {
-                    cases.push(sim_case(
-                        "main",
-                        "effect",
-                        noise,
-                        seed,
-                        calibrate,
-                        Some(k),
-                        vec![],
-                        vec![(e.clone(), mag)],
-                    ));
-                }
-            }
-        }
-    };
-    for &noise in &opts.noise_levels {
-        singles(noise, true, &mut cases);
-    }
-    if let Some(noise) = opts.calibration_off_noise {
-        singles(noise, false, &mut cases);
-    }
-    // Pairs.
-    for (i, a) in effect_names.iter().enumerate() {
-        for b in &effect_names[i + 1..] {
-            let (Some(ta), Some(tb)) = (thr_of(opts.pair_noise, a), thr_of(opts.pair_noise, b))
-            else {
-                continue;
-            };
-            let mag = |e: &str| {
-                magnitude_at(
-                    lib,
-                    &design,
-                    e,
-                    if e == a { ta } else { tb },
-                    opts.pair_multiple,
-                )
-            };
-            for seed in 0..opts.seeds {
-                cases.push(sim_case(
-                    "main",
-                    "pair",
-                    opts.pair_noise,
-                    seed,
-                    true,
-                    Some(opts.pair_multiple),
-                    vec![],
-                    vec![(a.clone(), mag(a)), (b.clone(), mag(b))],
-                ));
-            }
-        }
-    }
-    // Nominal-parameter errors.
-    for params in &opts.parameter_errors {
-        for &noise in &opts.parameter_noise {
-            for seed in 0..opts.seeds {
-                cases.push(sim_case(
-                    "main",
-                    "parameter",
-                    noise,
-                    seed,
-                    true,
-                    None,
-                    params.clone(),
-                    vec![],
-                ));
-            }
-        }
-    }
-    suites.push(main);
-
-    // One robot.
+    planner.main_cases();
+    let mut suites = vec![main];
     if opts.one_robot_null_cases > 0 {
-        let one = Suite::new(
-            "one-robot",
-            TrialSet {
-                origin: format!("one-robot conditions of {}", opts.design),
-                base_dir: PathBuf::from("."),
-                trials: one_robot_conditions(&opts.design)?,
-            },
-        )?;
-        let noise = 0.05;
-        for seed in 0..opts.one_robot_null_cases {
-            cases.push(sim_case(
-                "one-robot",
-                "null",
-                noise,
-                seed,
-                true,
-                None,
-                vec![],
-                vec![],
-            ));
-        }
-        for e in &effect_names {
-            let Some(t) = thr_of(noise, e) else { continue };
-            let mag = magnitude_at(lib, &design, e, t, 2.0);
-            for seed in 0..opts.seeds {
-                cases.push(sim_case(
-                    "one-robot",
-                    "effect",
-                    noise,
-                    seed,
-                    true,
-                    Some(2.0),
-                    vec![],
-                    vec![(e.clone(), mag)],
-                ));
-            }
-        }
-        for params in &opts.parameter_errors {
-            for seed in 0..opts.seeds {
-                cases.push(sim_case(
-                    "one-robot",
-                    "parameter",
-                    noise,
-                    seed,
-                    true,
-                    None,
-                    params.clone(),
-                    vec![],
-                ));
-            }
-        }
-        suites.push(one);
+        suites.push(planner.one_robot_cases()?);
     }
-
-    // Drake.
+    let mut cases = planner.cases;
     let mut drake = BTreeMap::new();
     if let Some(dir) = &opts.drake_dir {
-        let mut files: Vec<PathBuf> = std::fs::read_dir(dir)
-            .map_err(|source| GapError::Read {
-                path: dir.clone(),
-                source,
-            })?
-            .filter_map(|e| e.ok().map(|e| e.path()))
-            .filter(|p| {
-                p.file_name()
-                    .and_then(|f| f.to_str())
-                    .is_some_and(|f| f.starts_with("trials-") && f.ends_with(".csv"))
-            })
-            .collect();
-        files.sort();
-        for f in files {
-            let set = TrialSet::read(&f)?;
-            let name = f
-                .file_stem()
-                .and_then(|s| s.to_str())
-                .unwrap_or("")
-                .to_string();
-            let effect = name
-                .strip_prefix("trials-")
-                .and_then(|rest| rest.rsplit_once('-'))
-                .and_then(|(e, v)| Some((e.to_string(), v.parse::<f64>().ok()?)));
-            // One suite serves every Drake file: its conditions must be the first file's.
-            if let Some((first, _)) = drake.values().next()
-                && !same_conditions(first, &set)
-            {
-                return Err(GapError::File {
-                    path: f.display().to_string(),
-                    message: format!(
-                        "its conditions differ from those of the other Drake trials files in {}",
-                        dir.display()
-                    ),
-                });
-            }
-            let truth: Vec<SimMetrics> = set.trials.iter().map(SimMetrics::measured_by).collect();
-            for seed in 0..opts.drake_seeds {
-                let key = format!("drake/{name}/n{}/s{seed}", opts.pair_noise);
-                cases.push(CaseSpec {
-                    key,
-                    suite: "drake".into(),
-                    kind: "drake".into(),
-                    noise: opts.pair_noise,
-                    seed,
-                    calibrate: true,
-                    multiple: None,
-                    truth: Truth::Drake {
-                        file: name.clone(),
-                        effect: effect.clone(),
-                    },
-                });
-            }
-            drake.insert(name, (set, truth));
-        }
+        drake = drake_cases(opts, dir, &mut cases)?;
         if let Some((set, _)) = drake.values().next() {
             let mut base = set.clone();
             for t in base.trials.iter_mut() {
@@ -745,10 +433,370 @@ pub fn plan(
     cases.retain(|c| seen.insert(c.key.clone()));
     Ok(Plan {
         cases,
-        thresholds: thr_table,
+        thresholds: thr.table,
         suites,
         drake,
     })
+}
+
+/// The main suite's identification thresholds per noise level (keyed by `{noise}`).
+struct Thresholds {
+    /// Every effect, `None` when not identifiable within its range (for the report).
+    table: BTreeMap<String, Vec<(String, Option<f64>)>>,
+    /// With calibration.
+    on: BTreeMap<String, BTreeMap<String, f64>>,
+    /// Calibration off (only at `calibration_off_noise`).
+    off: BTreeMap<String, BTreeMap<String, f64>>,
+}
+
+impl Thresholds {
+    /// The thresholds at every noise level of the null/single cases and at the pair noise.
+    fn of_main(
+        lib: &EffectLibrary,
+        opts: &BenchmarkOptions,
+        main: &Suite,
+        effect_names: &[String],
+        progress: &(dyn Fn(&str) + Sync),
+    ) -> Result<Thresholds, GapError> {
+        let nominal = main
+            .cache
+            .get(&main.conditions, lib, &ModelSetting::nominal(), &|| {})?;
+        let mut noise_for_thr: Vec<f64> = opts.noise_levels.clone();
+        noise_for_thr.push(opts.pair_noise);
+        noise_for_thr.sort_by(f64::total_cmp);
+        noise_for_thr.dedup();
+        let mut out = Thresholds {
+            table: BTreeMap::new(),
+            on: BTreeMap::new(),
+            off: BTreeMap::new(),
+        };
+        let at = |noise: f64, effects: &[String], calibrate: bool| {
+            thresholds(
+                &main.base,
+                &main.conditions,
+                &nominal,
+                lib,
+                noise,
+                effects,
+                calibrate,
+                &main.cache,
+            )
+        };
+        let named = |ids: &[Identifiability]| -> BTreeMap<String, f64> {
+            ids.iter()
+                .filter_map(|i| i.identification_threshold.map(|t| (i.effect.clone(), t)))
+                .collect()
+        };
+        for &noise in &noise_for_thr {
+            progress(&format!("thresholds at {} % noise", noise * 100.0));
+            if opts.calibration_off_noise == Some(noise) {
+                let off = at(noise, &opts.effects, false)?;
+                out.off.insert(format!("{noise}"), named(&off));
+            }
+            let mut ids = at(noise, &opts.effects, true)?;
+            // Effects the design calibrates as a parameter have no effect knob: their
+            // threshold against the other effects (calibration off).
+            let missing: Vec<String> = effect_names
+                .iter()
+                .filter(|e| !ids.iter().any(|i| &i.effect == *e))
+                .cloned()
+                .collect();
+            if !missing.is_empty() {
+                let off = at(noise, &missing, false)?;
+                ids.extend(off);
+                ids.sort_by(|a, b| a.effect.cmp(&b.effect));
+            }
+            let key = format!("{noise}");
+            // An effect not identifiable within its range has no threshold: no case of it
+            // is made (the report lists it), since "k times the threshold" does not exist.
+            out.table.insert(
+                key.clone(),
+                ids.iter()
+                    .map(|i| (i.effect.clone(), i.identification_threshold))
+                    .collect(),
+            );
+            out.on.insert(key, named(&ids));
+        }
+        Ok(out)
+    }
+
+    /// An effect's threshold at a noise level, with calibration on or off.
+    fn get(&self, noise: f64, e: &str, calibrate: bool) -> Option<f64> {
+        let map = if calibrate { &self.on } else { &self.off };
+        map.get(&format!("{noise}")).and_then(|m| m.get(e)).copied()
+    }
+}
+
+/// A case whose trials the simulator makes; its key is the truth.
+#[allow(clippy::too_many_arguments)]
+fn sim_case(
+    suite: &str,
+    kind: &str,
+    noise: f64,
+    seed: u64,
+    calibrate: bool,
+    multiple: Option<f64>,
+    params: Vec<(String, f64)>,
+    effects: Vec<(String, f64)>,
+) -> CaseSpec {
+    let key = format!(
+        "{suite}/{kind}/{}/{}/n{noise}/s{seed}{}",
+        pairs(&effects),
+        pairs(&params),
+        if calibrate { "" } else { "/nocal" }
+    );
+    CaseSpec {
+        key,
+        suite: suite.into(),
+        kind: kind.into(),
+        noise,
+        seed,
+        calibrate,
+        multiple,
+        truth: Truth::Sim { params, effects },
+    }
+}
+
+/// Makes the simulated cases, in the plan's order.
+struct Planner<'a> {
+    lib: &'a EffectLibrary,
+    opts: &'a BenchmarkOptions,
+    design: &'a Design,
+    effect_names: &'a [String],
+    thr: &'a Thresholds,
+    cases: Vec<CaseSpec>,
+}
+
+impl Planner<'_> {
+    /// The main suite: nulls, single effects (and again with calibration off), pairs,
+    /// nominal-parameter errors.
+    fn main_cases(&mut self) {
+        let opts = self.opts;
+        for &noise in &opts.noise_levels {
+            for seed in 0..opts.null_cases {
+                self.cases.push(sim_case(
+                    "main",
+                    "null",
+                    noise,
+                    seed,
+                    true,
+                    None,
+                    vec![],
+                    vec![],
+                ));
+            }
+        }
+        for &noise in &opts.noise_levels {
+            self.singles(noise, true);
+        }
+        if let Some(noise) = opts.calibration_off_noise {
+            self.singles(noise, false);
+        }
+        self.pairs();
+        for params in &opts.parameter_errors {
+            for &noise in &opts.parameter_noise {
+                for seed in 0..opts.seeds {
+                    self.cases.push(sim_case(
+                        "main",
+                        "parameter",
+                        noise,
+                        seed,
+                        true,
+                        None,
+                        params.clone(),
+                        vec![],
+                    ));
+                }
+            }
+        }
+    }
+
+    /// Every effect alone at each multiple of its threshold.
+    fn singles(&mut self, noise: f64, calibrate: bool) {
+        for e in self.effect_names {
+            let Some(t) = self.thr.get(noise, e, calibrate) else {
+                continue;
+            };
+            for &k in &self.opts.multiples {
+                let mag = magnitude_at(self.lib, self.design, e, t, k);
+                for seed in 0..self.opts.seeds {
+                    self.cases.push(sim_case(
+                        "main",
+                        "effect",
+                        noise,
+                        seed,
+                        calibrate,
+                        Some(k),
+                        vec![],
+                        vec![(e.clone(), mag)],
+                    ));
+                }
+            }
+        }
+    }
+
+    /// Every pair of effects, each at the pair multiple of its threshold.
+    fn pairs(&mut self) {
+        let opts = self.opts;
+        for (i, a) in self.effect_names.iter().enumerate() {
+            for b in &self.effect_names[i + 1..] {
+                let (Some(ta), Some(tb)) = (
+                    self.thr.get(opts.pair_noise, a, true),
+                    self.thr.get(opts.pair_noise, b, true),
+                ) else {
+                    continue;
+                };
+                let mag = |e: &str| {
+                    magnitude_at(
+                        self.lib,
+                        self.design,
+                        e,
+                        if e == a { ta } else { tb },
+                        opts.pair_multiple,
+                    )
+                };
+                let effects = vec![(a.clone(), mag(a)), (b.clone(), mag(b))];
+                for seed in 0..opts.seeds {
+                    self.cases.push(sim_case(
+                        "main",
+                        "pair",
+                        opts.pair_noise,
+                        seed,
+                        true,
+                        Some(opts.pair_multiple),
+                        vec![],
+                        effects.clone(),
+                    ));
+                }
+            }
+        }
+    }
+
+    /// The one-robot suite at 5 % noise: nulls, single effects at 2× their (main-suite)
+    /// threshold, nominal-parameter errors.
+    fn one_robot_cases(&mut self) -> Result<Suite, GapError> {
+        let opts = self.opts;
+        let one = Suite::new(
+            "one-robot",
+            TrialSet {
+                origin: format!("one-robot conditions of {}", opts.design),
+                base_dir: PathBuf::from("."),
+                trials: one_robot_conditions(&opts.design)?,
+            },
+        )?;
+        let noise = 0.05;
+        for seed in 0..opts.one_robot_null_cases {
+            self.cases.push(sim_case(
+                "one-robot",
+                "null",
+                noise,
+                seed,
+                true,
+                None,
+                vec![],
+                vec![],
+            ));
+        }
+        for e in self.effect_names {
+            let Some(t) = self.thr.get(noise, e, true) else {
+                continue;
+            };
+            let mag = magnitude_at(self.lib, self.design, e, t, 2.0);
+            for seed in 0..opts.seeds {
+                self.cases.push(sim_case(
+                    "one-robot",
+                    "effect",
+                    noise,
+                    seed,
+                    true,
+                    Some(2.0),
+                    vec![],
+                    vec![(e.clone(), mag)],
+                ));
+            }
+        }
+        for params in &opts.parameter_errors {
+            for seed in 0..opts.seeds {
+                self.cases.push(sim_case(
+                    "one-robot",
+                    "parameter",
+                    noise,
+                    seed,
+                    true,
+                    None,
+                    params.clone(),
+                    vec![],
+                ));
+            }
+        }
+        Ok(one)
+    }
+}
+
+/// The Drake cases: every `trials-*.csv` of `dir` (named `trials-<effect>-<value>` when
+/// Drake added an effect), `drake_seeds` noisy copies each. Returns the truths by file.
+fn drake_cases(
+    opts: &BenchmarkOptions,
+    dir: &Path,
+    cases: &mut Vec<CaseSpec>,
+) -> Result<BTreeMap<String, (TrialSet, Vec<SimMetrics>)>, GapError> {
+    let mut drake: BTreeMap<String, (TrialSet, Vec<SimMetrics>)> = BTreeMap::new();
+    let mut files: Vec<PathBuf> = std::fs::read_dir(dir)
+        .map_err(|source| GapError::Read {
+            path: dir.to_path_buf(),
+            source,
+        })?
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .filter(|p| {
+            p.file_name()
+                .and_then(|f| f.to_str())
+                .is_some_and(|f| f.starts_with("trials-") && f.ends_with(".csv"))
+        })
+        .collect();
+    files.sort();
+    for f in files {
+        let set = TrialSet::read(&f)?;
+        let name = f
+            .file_stem()
+            .and_then(|s| s.to_str())
+            .unwrap_or("")
+            .to_string();
+        let effect = name
+            .strip_prefix("trials-")
+            .and_then(|rest| rest.rsplit_once('-'))
+            .and_then(|(e, v)| Some((e.to_string(), v.parse::<f64>().ok()?)));
+        // One suite serves every Drake file: its conditions must be the first file's.
+        if let Some((first, _)) = drake.values().next()
+            && !same_conditions(first, &set)
+        {
+            return Err(GapError::File {
+                path: f.display().to_string(),
+                message: format!(
+                    "its conditions differ from those of the other Drake trials files in {}",
+                    dir.display()
+                ),
+            });
+        }
+        let truth: Vec<SimMetrics> = set.trials.iter().map(SimMetrics::measured_by).collect();
+        for seed in 0..opts.drake_seeds {
+            let key = format!("drake/{name}/n{}/s{seed}", opts.pair_noise);
+            cases.push(CaseSpec {
+                key,
+                suite: "drake".into(),
+                kind: "drake".into(),
+                noise: opts.pair_noise,
+                seed,
+                calibrate: true,
+                multiple: None,
+                truth: Truth::Drake {
+                    file: name.clone(),
+                    effect: effect.clone(),
+                },
+            });
+        }
+        drake.insert(name, (set, truth));
+    }
+    Ok(drake)
 }
 
 /// The specification line of a benchmark's points file.
