@@ -1124,9 +1124,31 @@ pub fn summarize(
     opts: &BenchmarkOptions,
     thresholds: BTreeMap<String, Vec<(String, Option<f64>)>>,
 ) -> BenchmarkSummary {
-    let design = Design::resolve(&opts.design).ok();
-    let aliases: BTreeMap<String, String> = lib
-        .effects
+    let aliases = effect_aliases(lib, &opts.design);
+    let mut noise_levels: Vec<f64> = rows.iter().map(|r| r.noise).collect();
+    noise_levels.sort_by(f64::total_cmp);
+    noise_levels.dedup();
+    let mut scores = Vec::new();
+    null_scores(rows, &noise_levels, &mut scores);
+    single_effect_scores(rows, &noise_levels, &aliases, &mut scores);
+    pair_scores(rows, &aliases, &mut scores);
+    parameter_scores(rows, &mut scores);
+    drake_scores(rows, &aliases, &mut scores);
+    scores.push(coverage_score(rows, &aliases));
+    BenchmarkSummary {
+        design: opts.design.clone(),
+        cases: rows.len(),
+        scores,
+        confusions: confusions(rows, &noise_levels),
+        thresholds,
+    }
+}
+
+/// Effects that stand for a declared uncertain parameter of the design (effect → path):
+/// naming either is naming the truth.
+fn effect_aliases(lib: &EffectLibrary, design: &str) -> BTreeMap<String, String> {
+    let design = Design::resolve(design).ok();
+    lib.effects
         .iter()
         .filter_map(|e| {
             let f = e.replaces.clone()?;
@@ -1135,16 +1157,36 @@ pub fn summarize(
                 .is_some_and(|d| d.uncertain.iter().any(|u| u.path == f))
                 .then(|| (e.name.clone(), f))
         })
-        .collect();
-    let mut scores = Vec::new();
-    let any_named = |r: &CaseRow| !r.named_effects.is_empty() || !r.named_params.is_empty();
-    let effect_named = |r: &CaseRow| !r.named_effects.is_empty();
-    // Nulls.
-    let mut noise_levels: Vec<f64> = rows.iter().map(|r| r.noise).collect();
-    noise_levels.sort_by(f64::total_cmp);
-    noise_levels.dedup();
+        .collect()
+}
+
+fn any_named(r: &CaseRow) -> bool {
+    !r.named_effects.is_empty() || !r.named_params.is_empty()
+}
+
+fn effect_named(r: &CaseRow) -> bool {
+    !r.named_effects.is_empty()
+}
+
+/// An effect named that is not among the truth's effects.
+fn names_other_effect(r: &CaseRow) -> bool {
+    let t = parse_pairs(&r.truth_effects);
+    split(&r.named_effects)
+        .iter()
+        .any(|n| !t.iter().any(|(e, _)| e == n))
+}
+
+/// Every effect of the truth named (or its parameter alias).
+fn names_every_truth_effect(r: &CaseRow, aliases: &BTreeMap<String, String>) -> bool {
+    parse_pairs(&r.truth_effects)
+        .iter()
+        .all(|(e, _)| names_effect(r, e, aliases))
+}
+
+/// Nulls: false alarms per suite and noise level.
+fn null_scores(rows: &[CaseRow], noise_levels: &[f64], scores: &mut Vec<Score>) {
     for suite in ["main", "one-robot"] {
-        for &noise in &noise_levels {
+        for &noise in noise_levels {
             let nulls: Vec<&CaseRow> = rows
                 .iter()
                 .filter(|r| r.suite == suite && r.kind == "null" && r.noise == noise)
@@ -1163,10 +1205,18 @@ pub fn summarize(
             ));
         }
     }
-    // Single effects, per noise level, multiple ≥ 1.
+}
+
+/// Single effects, per suite, calibration and noise level, multiple ≥ 1.
+fn single_effect_scores(
+    rows: &[CaseRow],
+    noise_levels: &[f64],
+    aliases: &BTreeMap<String, String>,
+    scores: &mut Vec<Score>,
+) {
     for suite in ["main", "one-robot"] {
         for calibrate in [true, false] {
-            for &noise in &noise_levels {
+            for &noise in noise_levels {
                 let cases: Vec<&CaseRow> = rows
                     .iter()
                     .filter(|r| {
@@ -1181,20 +1231,9 @@ pub fn summarize(
                 }
                 let right = cases
                     .iter()
-                    .filter(|r| {
-                        let t = parse_pairs(&r.truth_effects);
-                        t.iter().all(|(e, _)| names_effect(r, e, &aliases))
-                    })
+                    .filter(|r| names_every_truth_effect(r, aliases))
                     .count();
-                let wrong = cases
-                    .iter()
-                    .filter(|r| {
-                        let t = parse_pairs(&r.truth_effects);
-                        split(&r.named_effects)
-                            .iter()
-                            .any(|n| !t.iter().any(|(e, _)| e == n))
-                    })
-                    .count();
+                let wrong = cases.iter().filter(|r| names_other_effect(r)).count();
                 let tag = if calibrate { "" } else { " (calibration off)" };
                 scores.push(score(
                     &format!("{suite}: single effect named{tag} at {:.0} % noise (×1, ×2, ×4 thresholds)", noise * 100.0),
@@ -1214,48 +1253,59 @@ pub fn summarize(
             }
         }
     }
-    // Pairs.
+}
+
+/// Pairs: both named, and a spurious third knob (effect, or a parameter that is not an
+/// alias of a truth effect).
+fn pair_scores(rows: &[CaseRow], aliases: &BTreeMap<String, String>, scores: &mut Vec<Score>) {
     let pairs_rows: Vec<&CaseRow> = rows.iter().filter(|r| r.kind == "pair").collect();
-    if !pairs_rows.is_empty() {
-        let both = pairs_rows
-            .iter()
-            .filter(|r| {
-                parse_pairs(&r.truth_effects)
-                    .iter()
-                    .all(|(e, _)| names_effect(r, e, &aliases))
-            })
-            .count();
-        let third = pairs_rows
-            .iter()
-            .filter(|r| {
-                let t = parse_pairs(&r.truth_effects);
-                let extra_effect = split(&r.named_effects)
-                    .iter()
-                    .any(|n| !t.iter().any(|(e, _)| e == n));
-                let extra_param = split(&r.named_params).iter().any(|n| {
-                    !t.iter().any(|(e, _)| {
-                        aliases
-                            .get(e)
-                            .is_some_and(|p| n.ends_with(&format!(":{p}")))
-                    })
-                });
-                extra_effect || extra_param
-            })
-            .count();
-        scores.push(score(
-            "pairs of effects at 2× thresholds: both named",
-            both,
-            pairs_rows.len(),
-            "≥ 80 %",
-        ));
-        scores.push(score(
-            "pairs: a spurious third knob named",
-            third,
-            pairs_rows.len(),
-            "≤ 5 %",
-        ));
+    if pairs_rows.is_empty() {
+        return;
     }
-    // Parameter errors.
+    let both = pairs_rows
+        .iter()
+        .filter(|r| names_every_truth_effect(r, aliases))
+        .count();
+    let third = pairs_rows
+        .iter()
+        .filter(|r| {
+            let t = parse_pairs(&r.truth_effects);
+            let extra_effect = names_other_effect(r);
+            let extra_param = split(&r.named_params).iter().any(|n| {
+                !t.iter().any(|(e, _)| {
+                    aliases
+                        .get(e)
+                        .is_some_and(|p| n.ends_with(&format!(":{p}")))
+                })
+            });
+            extra_effect || extra_param
+        })
+        .count();
+    scores.push(score(
+        "pairs of effects at 2× thresholds: both named",
+        both,
+        pairs_rows.len(),
+        "≥ 80 %",
+    ));
+    scores.push(score(
+        "pairs: a spurious third knob named",
+        third,
+        pairs_rows.len(),
+        "≤ 5 %",
+    ));
+}
+
+/// The truth's parameter paths.
+fn truth_params(r: &CaseRow) -> Vec<String> {
+    parse_pairs(&r.truth_params)
+        .into_iter()
+        .map(|(k, _)| k)
+        .collect()
+}
+
+/// Parameter errors per suite: an effect wrongly called, a wrong parameter named, the
+/// right declared parameter named, undeclared ones reported unexplained.
+fn parameter_scores(rows: &[CaseRow], scores: &mut Vec<Score>) {
     for suite in ["main", "one-robot"] {
         let p: Vec<&CaseRow> = rows
             .iter()
@@ -1271,10 +1321,7 @@ pub fn summarize(
             "≤ 5 %",
         ));
         let wrong_param = |r: &&&CaseRow| {
-            let truth: Vec<String> = parse_pairs(&r.truth_params)
-                .into_iter()
-                .map(|(k, _)| k)
-                .collect();
+            let truth = truth_params(r);
             split(&r.named_params)
                 .iter()
                 .any(|n| !truth.iter().any(|t| n.ends_with(&format!(":{t}"))))
@@ -1291,11 +1338,7 @@ pub fn summarize(
             declared
                 .iter()
                 .filter(|r| {
-                    let truth: Vec<String> = parse_pairs(&r.truth_params)
-                        .into_iter()
-                        .map(|(k, _)| k)
-                        .collect();
-                    truth.iter().all(|t| {
+                    truth_params(r).iter().all(|t| {
                         split(&r.named_params)
                             .iter()
                             .any(|n| n.ends_with(&format!(":{t}")))
@@ -1313,50 +1356,47 @@ pub fn summarize(
             "high",
         ));
     }
-    // Drake.
+}
+
+/// Drake trials: an effect blamed without one added; with one added, it named and
+/// another named.
+fn drake_scores(rows: &[CaseRow], aliases: &BTreeMap<String, String>, scores: &mut Vec<Score>) {
     let drake: Vec<&CaseRow> = rows.iter().filter(|r| r.kind == "drake").collect();
-    if !drake.is_empty() {
-        let nulls: Vec<&&CaseRow> = drake
-            .iter()
-            .filter(|r| r.truth_effects.is_empty())
-            .collect();
-        scores.push(score(
-            "Drake, no effect added: an effect blamed",
-            nulls.iter().filter(|r| effect_named(r)).count(),
-            nulls.len(),
-            "0 %",
-        ));
-        let with: Vec<&&CaseRow> = drake
-            .iter()
-            .filter(|r| !r.truth_effects.is_empty())
-            .collect();
-        scores.push(score(
-            "Drake, effect added: that effect named (on top of the engine difference)",
-            with.iter()
-                .filter(|r| {
-                    parse_pairs(&r.truth_effects)
-                        .iter()
-                        .all(|(e, _)| names_effect(r, e, &aliases))
-                })
-                .count(),
-            with.len(),
-            "high",
-        ));
-        scores.push(score(
-            "Drake, effect added: another effect named",
-            with.iter()
-                .filter(|r| {
-                    let t = parse_pairs(&r.truth_effects);
-                    split(&r.named_effects)
-                        .iter()
-                        .any(|n| !t.iter().any(|(e, _)| e == n))
-                })
-                .count(),
-            with.len(),
-            "low",
-        ));
+    if drake.is_empty() {
+        return;
     }
-    // Interval coverage over every case whose true knob was named with an interval.
+    let nulls: Vec<&&CaseRow> = drake
+        .iter()
+        .filter(|r| r.truth_effects.is_empty())
+        .collect();
+    scores.push(score(
+        "Drake, no effect added: an effect blamed",
+        nulls.iter().filter(|r| effect_named(r)).count(),
+        nulls.len(),
+        "0 %",
+    ));
+    let with: Vec<&&CaseRow> = drake
+        .iter()
+        .filter(|r| !r.truth_effects.is_empty())
+        .collect();
+    scores.push(score(
+        "Drake, effect added: that effect named (on top of the engine difference)",
+        with.iter()
+            .filter(|r| names_every_truth_effect(r, aliases))
+            .count(),
+        with.len(),
+        "high",
+    ));
+    scores.push(score(
+        "Drake, effect added: another effect named",
+        with.iter().filter(|r| names_other_effect(r)).count(),
+        with.len(),
+        "low",
+    ));
+}
+
+/// Interval coverage over every case whose true knob was named with an interval.
+fn coverage_score(rows: &[CaseRow], aliases: &BTreeMap<String, String>) -> Score {
     let mut cov = (0usize, 0usize);
     for r in rows {
         for (e, v) in parse_pairs(&r.truth_effects) {
@@ -1385,16 +1425,19 @@ pub fn summarize(
             }
         }
     }
-    scores.push(score(
+    score(
         "95 % intervals holding the truth (every case that named its true knob)",
         cov.0,
         cov.1,
         "90–97 %",
-    ));
-    // Confusions: single effects (main, calibration on) by noise; parameter errors.
+    )
+}
+
+/// Confusions: single effects (main) by calibration and noise; parameter errors.
+fn confusions(rows: &[CaseRow], noise_levels: &[f64]) -> Vec<Confusion> {
     let mut confusions = Vec::new();
     for calibrate in [true, false] {
-        for &noise in &noise_levels {
+        for &noise in noise_levels {
             let cases: Vec<&CaseRow> = rows
                 .iter()
                 .filter(|r| {
@@ -1436,37 +1479,29 @@ pub fn summarize(
             ));
         }
     }
-    {
-        let cases: Vec<&CaseRow> = rows
-            .iter()
-            .filter(|r| r.suite == "main" && r.kind == "parameter")
-            .collect();
-        if !cases.is_empty() {
-            let label = |r: &CaseRow| -> String {
-                let mut v: Vec<String> = split(&r.named_params)
-                    .iter()
-                    .map(|p| p.split(':').nth(1).unwrap_or(p).to_string())
-                    .collect();
-                v.extend(split(&r.named_effects));
-                if v.is_empty() {
-                    "none".into()
-                } else {
-                    v.join(" + ")
-                }
-            };
-            confusions.push(confusion(
-                "nominal-parameter errors (main suite): what was named".into(),
-                &cases,
-                |r| r.truth_params.clone(),
-                label,
-            ));
-        }
+    let cases: Vec<&CaseRow> = rows
+        .iter()
+        .filter(|r| r.suite == "main" && r.kind == "parameter")
+        .collect();
+    if !cases.is_empty() {
+        let label = |r: &CaseRow| -> String {
+            let mut v: Vec<String> = split(&r.named_params)
+                .iter()
+                .map(|p| p.split(':').nth(1).unwrap_or(p).to_string())
+                .collect();
+            v.extend(split(&r.named_effects));
+            if v.is_empty() {
+                "none".into()
+            } else {
+                v.join(" + ")
+            }
+        };
+        confusions.push(confusion(
+            "nominal-parameter errors (main suite): what was named".into(),
+            &cases,
+            |r| r.truth_params.clone(),
+            label,
+        ));
     }
-    BenchmarkSummary {
-        design: opts.design.clone(),
-        cases: rows.len(),
-        scores,
-        confusions,
-        thresholds,
-    }
+    confusions
 }
