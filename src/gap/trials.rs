@@ -248,20 +248,20 @@ impl TrialSet {
     /// only on a row of another length than the header, which [`TrialSet::csv_for`]
     /// reports; this gives the text written up to there.
     pub fn to_csv(&self) -> String {
-        match self.write_csv(&self.origin) {
-            Ok(text) => text,
-            Err((partial, _)) => partial,
-        }
+        self.write_csv().0
     }
 
     /// The trials as CSV for the file `path`; a write error names that file.
     pub fn csv_for(&self, path: &Path) -> Result<String, GapError> {
-        self.write_csv(&path.display().to_string())
-            .map_err(|(_, e)| e)
+        let (text, result) = self.write_csv();
+        result.map(|()| text).map_err(|e| GapError::File {
+            path: path.display().to_string(),
+            message: format!("cannot write the trials as CSV: {e}"),
+        })
     }
 
-    /// The CSV text, or the text written so far and the error (naming `file`).
-    fn write_csv(&self, file: &str) -> Result<String, (String, GapError)> {
+    /// The CSV text written, and the first write error (the rows after it are not written).
+    fn write_csv(&self) -> (String, Result<(), csv::Error>) {
         let mut w = csv::WriterBuilder::new().from_writer(Vec::new());
         let result = std::iter::once(w.write_record(columns()))
             .chain(self.trials.iter().map(|t| w.write_record(trial_row(t))))
@@ -270,16 +270,7 @@ impl TrialSet {
             .into_inner()
             .map(|v| String::from_utf8(v).unwrap_or_default())
             .unwrap_or_default();
-        match result {
-            Ok(()) => Ok(text),
-            Err(e) => Err((
-                text,
-                GapError::File {
-                    path: file.to_string(),
-                    message: format!("cannot write the trials as CSV: {e}"),
-                },
-            )),
-        }
+        (text, result)
     }
 }
 
