@@ -398,165 +398,236 @@ fn window(t: &[f64], lo: f64, hi: f64) -> std::ops::Range<usize> {
 /// diagnostics); `None` where a quantity is undefined (e.g. never stopped).
 pub type Measured = BTreeMap<String, Option<f64>>;
 
+/// The cases the project knows how to measure (by their name in cases.toml).
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum CaseKind {
+    /// Any case whose name starts with `sinkage`.
+    Sinkage,
+    FreeRocking,
+    RollingIncline,
+    SpinDown,
+    Slide,
+    Creep,
+    ServoInAir,
+}
+
+impl CaseKind {
+    fn of(name: &str) -> Option<CaseKind> {
+        Some(match name {
+            n if n.starts_with("sinkage") => CaseKind::Sinkage,
+            "free_rocking" => CaseKind::FreeRocking,
+            "rolling_incline" => CaseKind::RollingIncline,
+            "spin_down" => CaseKind::SpinDown,
+            "slide" => CaseKind::Slide,
+            "creep" => CaseKind::Creep,
+            "servo_in_air" => CaseKind::ServoInAir,
+            _ => return None,
+        })
+    }
+}
+
 /// Runs a case in the project's engine and measures it as the Drake harness does.
 pub fn run_case(root: &Path, name: &str, case: &Case) -> Result<Measured, CrosscheckError> {
     let design = case_design(root, case)?;
     let (tr, d) = run_trace(&design, case)?;
-    let t = &tr.t;
-    let mut m = Measured::new();
-    let mut put = |k: &str, v: Option<f64>| {
-        m.insert(k.to_string(), v);
-    };
     let unknown = || CrosscheckError::Invalid {
         path: PathBuf::from("cases.toml"),
         message: format!("case `{name}`: no measurement defined for it in the project"),
     };
-    if name.starts_with("sinkage") {
-        let w = window(t, t[t.len() - 1] - 0.2, f64::INFINITY);
-        let n = w.len() as f64;
-        let z0 = tr.hip[0].z;
-        let z_end = tr.hip[w.clone()].iter().map(|p| p.z).sum::<f64>() / n;
-        put("sinkage_m", Some(z0 - z_end));
-        put(
-            "left_normal_force_n",
-            Some(tr.normal_n[w.clone()].iter().map(|f| f[0]).sum::<f64>() / n),
-        );
-        put(
-            "right_normal_force_n",
-            Some(tr.normal_n[w.clone()].iter().map(|f| f[1]).sum::<f64>() / n),
-        );
-        put(
-            "feet_in_contact",
-            Some((tr.feet[w].iter().map(|&f| f as f64).sum::<f64>() / n).round()),
-        );
-    } else if name == "free_rocking" {
-        let zc = zero_crossings(t, &tr.roll_deg);
-        let mut pk = vec![(0.0, tr.roll_deg[0])];
-        pk.extend(positive_peaks(t, &tr.roll_deg));
-        let period = if zc.len() >= 9 {
-            Some((0..7).map(|k| zc[k + 2] - zc[k]).sum::<f64>() / 7.0)
-        } else if zc.len() >= 3 {
-            Some((0..zc.len() - 2).map(|k| zc[k + 2] - zc[k]).sum::<f64>() / (zc.len() - 2) as f64)
-        } else {
-            None
-        };
-        put("roll_period_s", period);
-        put(
-            "roll_decay_ratio_per_cycle",
-            (pk.len() >= 5).then(|| (pk[4].1 / pk[0].1).powf(0.25)),
-        );
-        put(
-            "both_feet_in_contact_fraction",
-            Some(tr.feet[1..].iter().filter(|&&f| f == 2).count() as f64 / (t.len() - 1) as f64),
-        );
-    } else if name == "rolling_incline" {
-        let x: Vec<f64> = tr.com.iter().map(|c| c.x).collect();
-        for (key, lo, hi) in [
-            ("com_acceleration_mps2", 0.05, 1.0),
-            ("com_acceleration_early_mps2", 0.05, 0.25),
-        ] {
-            let w = window(t, lo, hi);
-            put(key, quadratic_acceleration(&t[w.clone()], &x[w]));
-        }
-        let r = d.geometry.foot_semi_axes_m[2];
-        let last = t.len() - 1;
-        put("com_velocity_at_end_mps", Some(tr.vcom[last].x));
-        put(
-            "slip_velocity_at_end_mps",
-            Some(tr.vcom[last].x - tr.omega_left_w[last].y * r),
-        );
-    } else if name == "spin_down" {
-        let wz: Vec<f64> = tr.omega_left_w.iter().map(|w| w.z).collect();
-        let w0 = case.initial.angular_velocity_rad_s[2];
-        let (ts, ys): (Vec<f64>, Vec<f64>) = t
-            .iter()
-            .zip(&wz)
-            .filter(|&(&ti, &y)| ti > 0.0 && y >= 0.1 * w0 && y <= 0.9 * w0)
-            .map(|(&a, &b)| (a, b))
-            .unzip();
-        put("yaw_deceleration_rad_s2", line_slope(&ts, &ys).map(|s| -s));
-        put("stop_time_s", first_below(t, &wz, 0.01 * w0));
-        put("yaw_rate_at_end_rad_s", Some(wz[wz.len() - 1]));
-    } else if name == "slide" {
-        let v: Vec<f64> = tr.vcom.iter().map(|c| c.x).collect();
-        let x: Vec<f64> = tr.com.iter().map(|c| c.x).collect();
-        let v0 = case.initial.linear_velocity_mps[0];
-        let (ts, ys): (Vec<f64>, Vec<f64>) = t
-            .iter()
-            .zip(&v)
-            .filter(|&(&ti, &y)| ti > 0.0 && y >= 0.1 * v0 && y <= 0.9 * v0)
-            .map(|(&a, &b)| (a, b))
-            .unzip();
-        let stop = first_below(t, &v, 0.01 * v0);
-        let distance = stop.map(|ts| interp_at(t, &x, ts) - x[0]);
-        put("stop_time_s", stop);
-        put("stopping_distance_m", distance);
-        put("deceleration_mps2", stop.map(|ts| v0 / ts));
-        put(
-            "deceleration_from_distance_mps2",
-            distance.map(|d| v0 * v0 / (2.0 * d)),
-        );
-        put(
-            "deceleration_linefit_mps2",
-            line_slope(&ts, &ys).map(|s| -s),
-        );
-        let z0 = tr.hip[0].z;
-        put(
-            "max_hop_height_m",
-            Some(
-                tr.hip
-                    .iter()
-                    .map(|p| p.z - z0)
-                    .fold(f64::NEG_INFINITY, f64::max),
-            ),
-        );
-        put(
-            "airborne_fraction_while_sliding",
-            stop.map(|ts| {
-                let k = t[1..].iter().filter(|&&ti| ti < ts).count();
-                let air = t[1..]
-                    .iter()
-                    .zip(&tr.feet[1..])
-                    .filter(|&(&ti, &f)| ti < ts && f == 0)
-                    .count();
-                air as f64 / k.max(1) as f64
-            }),
-        );
-        put("velocity_at_end_mps", Some(v[v.len() - 1]));
-    } else if name == "creep" {
-        let x: Vec<f64> = tr.com.iter().map(|c| c.x).collect();
-        put(
-            "creep_speed_mps",
-            Some((interp_at(t, &x, 1.0) - interp_at(t, &x, 0.5)) / 0.5),
-        );
-        put("creep_speed_at_end_mps", Some(tr.vcom[tr.vcom.len() - 1].x));
-        put("displacement_m", Some(x[x.len() - 1] - x[0]));
-    } else if name == "servo_in_air" {
-        let (amp_rad, freq) = match d.control {
-            crate::sim::design::ControlSpec::ServoSine {
-                amplitude_deg,
-                frequency_hz,
-                ..
-            } => (amplitude_deg.to_radians(), frequency_hz),
-            _ => return Err(unknown()),
-        };
-        let w = window(t, 2.0, 3.0);
-        let fit = fit_sine(
-            &t[w.clone()],
-            &tr.hip_angle_rad[w.clone()],
-            std::f64::consts::TAU * freq,
-        );
-        put("amplitude_deg", fit.map(|f| f.0.to_degrees()));
-        put("amplitude_ratio", fit.map(|f| f.0 / amp_rad));
-        put("phase_lag_deg", fit.map(|f| f.1.to_degrees()));
-        put(
-            "peak_abs_torque_nm_last_second",
-            Some(tr.torque_nm[w].iter().fold(0.0, |a: f64, b| a.max(b.abs()))),
-        );
-    } else {
-        return Err(unknown());
+    let mut m = Measured::new();
+    let mut put = |k: &str, v: Option<f64>| {
+        m.insert(k.to_string(), v);
+    };
+    match CaseKind::of(name).ok_or_else(unknown)? {
+        CaseKind::Sinkage => measure_sinkage(&tr, &mut put),
+        CaseKind::FreeRocking => measure_free_rocking(&tr, &mut put),
+        CaseKind::RollingIncline => measure_rolling_incline(&tr, &d, &mut put),
+        CaseKind::SpinDown => measure_spin_down(&tr, case, &mut put),
+        CaseKind::Slide => measure_slide(&tr, case, &mut put),
+        CaseKind::Creep => measure_creep(&tr, &mut put),
+        CaseKind::ServoInAir => measure_servo_in_air(&tr, &d, &mut put).ok_or_else(unknown)?,
     }
     Ok(m)
+}
+
+/// Where each measurement goes: a quantity's name and value.
+type Put<'a> = dyn FnMut(&str, Option<f64>) + 'a;
+
+/// Sinkage: hip height lost, normal forces and feet in contact over the last 0.2 s.
+fn measure_sinkage(tr: &Trace, put: &mut Put) {
+    let t = &tr.t;
+    let w = window(t, t[t.len() - 1] - 0.2, f64::INFINITY);
+    let n = w.len() as f64;
+    let z0 = tr.hip[0].z;
+    let z_end = tr.hip[w.clone()].iter().map(|p| p.z).sum::<f64>() / n;
+    put("sinkage_m", Some(z0 - z_end));
+    put(
+        "left_normal_force_n",
+        Some(tr.normal_n[w.clone()].iter().map(|f| f[0]).sum::<f64>() / n),
+    );
+    put(
+        "right_normal_force_n",
+        Some(tr.normal_n[w.clone()].iter().map(|f| f[1]).sum::<f64>() / n),
+    );
+    put(
+        "feet_in_contact",
+        Some((tr.feet[w].iter().map(|&f| f as f64).sum::<f64>() / n).round()),
+    );
+}
+
+/// Free rocking: roll period (mean of up to seven full periods between zero crossings),
+/// decay per cycle over four peaks, time with both feet down.
+fn measure_free_rocking(tr: &Trace, put: &mut Put) {
+    let t = &tr.t;
+    let zc = zero_crossings(t, &tr.roll_deg);
+    let mut pk = vec![(0.0, tr.roll_deg[0])];
+    pk.extend(positive_peaks(t, &tr.roll_deg));
+    let period = if zc.len() >= 9 {
+        Some((0..7).map(|k| zc[k + 2] - zc[k]).sum::<f64>() / 7.0)
+    } else if zc.len() >= 3 {
+        Some((0..zc.len() - 2).map(|k| zc[k + 2] - zc[k]).sum::<f64>() / (zc.len() - 2) as f64)
+    } else {
+        None
+    };
+    put("roll_period_s", period);
+    put(
+        "roll_decay_ratio_per_cycle",
+        (pk.len() >= 5).then(|| (pk[4].1 / pk[0].1).powf(0.25)),
+    );
+    put(
+        "both_feet_in_contact_fraction",
+        Some(tr.feet[1..].iter().filter(|&&f| f == 2).count() as f64 / (t.len() - 1) as f64),
+    );
+}
+
+/// Rolling down an incline: centre-of-mass acceleration (quadratic fits, whole and early),
+/// velocity and slip at the end.
+fn measure_rolling_incline(tr: &Trace, d: &Design, put: &mut Put) {
+    let t = &tr.t;
+    let x: Vec<f64> = tr.com.iter().map(|c| c.x).collect();
+    for (key, lo, hi) in [
+        ("com_acceleration_mps2", 0.05, 1.0),
+        ("com_acceleration_early_mps2", 0.05, 0.25),
+    ] {
+        let w = window(t, lo, hi);
+        put(key, quadratic_acceleration(&t[w.clone()], &x[w]));
+    }
+    let r = d.geometry.foot_semi_axes_m[2];
+    let last = t.len() - 1;
+    put("com_velocity_at_end_mps", Some(tr.vcom[last].x));
+    put(
+        "slip_velocity_at_end_mps",
+        Some(tr.vcom[last].x - tr.omega_left_w[last].y * r),
+    );
+}
+
+/// Spin-down: yaw deceleration fitted between 90 % and 10 % of the initial rate, the
+/// time to 1 %, the rate at the end.
+fn measure_spin_down(tr: &Trace, case: &Case, put: &mut Put) {
+    let t = &tr.t;
+    let wz: Vec<f64> = tr.omega_left_w.iter().map(|w| w.z).collect();
+    let w0 = case.initial.angular_velocity_rad_s[2];
+    let (ts, ys): (Vec<f64>, Vec<f64>) = t
+        .iter()
+        .zip(&wz)
+        .filter(|&(&ti, &y)| ti > 0.0 && y >= 0.1 * w0 && y <= 0.9 * w0)
+        .map(|(&a, &b)| (a, b))
+        .unzip();
+    put("yaw_deceleration_rad_s2", line_slope(&ts, &ys).map(|s| -s));
+    put("stop_time_s", first_below(t, &wz, 0.01 * w0));
+    put("yaw_rate_at_end_rad_s", Some(wz[wz.len() - 1]));
+}
+
+/// Sliding to a stop: stop time and distance, deceleration three ways, hops and the
+/// airborne fraction while sliding.
+fn measure_slide(tr: &Trace, case: &Case, put: &mut Put) {
+    let t = &tr.t;
+    let v: Vec<f64> = tr.vcom.iter().map(|c| c.x).collect();
+    let x: Vec<f64> = tr.com.iter().map(|c| c.x).collect();
+    let v0 = case.initial.linear_velocity_mps[0];
+    let (ts, ys): (Vec<f64>, Vec<f64>) = t
+        .iter()
+        .zip(&v)
+        .filter(|&(&ti, &y)| ti > 0.0 && y >= 0.1 * v0 && y <= 0.9 * v0)
+        .map(|(&a, &b)| (a, b))
+        .unzip();
+    let stop = first_below(t, &v, 0.01 * v0);
+    let distance = stop.map(|ts| interp_at(t, &x, ts) - x[0]);
+    put("stop_time_s", stop);
+    put("stopping_distance_m", distance);
+    put("deceleration_mps2", stop.map(|ts| v0 / ts));
+    put(
+        "deceleration_from_distance_mps2",
+        distance.map(|d| v0 * v0 / (2.0 * d)),
+    );
+    put(
+        "deceleration_linefit_mps2",
+        line_slope(&ts, &ys).map(|s| -s),
+    );
+    let z0 = tr.hip[0].z;
+    put(
+        "max_hop_height_m",
+        Some(
+            tr.hip
+                .iter()
+                .map(|p| p.z - z0)
+                .fold(f64::NEG_INFINITY, f64::max),
+        ),
+    );
+    put(
+        "airborne_fraction_while_sliding",
+        stop.map(|ts| {
+            let k = t[1..].iter().filter(|&&ti| ti < ts).count();
+            let air = t[1..]
+                .iter()
+                .zip(&tr.feet[1..])
+                .filter(|&(&ti, &f)| ti < ts && f == 0)
+                .count();
+            air as f64 / k.max(1) as f64
+        }),
+    );
+    put("velocity_at_end_mps", Some(v[v.len() - 1]));
+}
+
+/// Creep: speed between 0.5 s and 1 s, at the end, and the displacement.
+fn measure_creep(tr: &Trace, put: &mut Put) {
+    let t = &tr.t;
+    let x: Vec<f64> = tr.com.iter().map(|c| c.x).collect();
+    put(
+        "creep_speed_mps",
+        Some((interp_at(t, &x, 1.0) - interp_at(t, &x, 0.5)) / 0.5),
+    );
+    put("creep_speed_at_end_mps", Some(tr.vcom[tr.vcom.len() - 1].x));
+    put("displacement_m", Some(x[x.len() - 1] - x[0]));
+}
+
+/// A servo driving the legs in the air: a sine fitted to the hip angle over 2–3 s
+/// (amplitude, ratio, phase lag) and the peak torque. `None` when the design is not
+/// servo-driven (then the case has no measurement).
+fn measure_servo_in_air(tr: &Trace, d: &Design, put: &mut Put) -> Option<()> {
+    let t = &tr.t;
+    let (amp_rad, freq) = match d.control {
+        crate::sim::design::ControlSpec::ServoSine {
+            amplitude_deg,
+            frequency_hz,
+            ..
+        } => (amplitude_deg.to_radians(), frequency_hz),
+        _ => return None,
+    };
+    let w = window(t, 2.0, 3.0);
+    let fit = fit_sine(
+        &t[w.clone()],
+        &tr.hip_angle_rad[w.clone()],
+        std::f64::consts::TAU * freq,
+    );
+    put("amplitude_deg", fit.map(|f| f.0.to_degrees()));
+    put("amplitude_ratio", fit.map(|f| f.0 / amp_rad));
+    put("phase_lag_deg", fit.map(|f| f.1.to_degrees()));
+    put(
+        "peak_abs_torque_nm_last_second",
+        Some(tr.torque_nm[w].iter().fold(0.0, |a: f64, b| a.max(b.abs()))),
+    );
+    Some(())
 }
 
 /// A walk compared in both engines: the same design TOML and options.

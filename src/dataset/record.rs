@@ -498,201 +498,250 @@ fn parse_values(
         return out;
     };
     for (name, raw) in values {
-        let field = format!("values.{name}");
-        let mk = |rule, msg: String| {
-            let mut pr = Problem::error(file, rule, msg)
-                .field(field.clone())
-                .line(line_of_key(text, name));
-            pr.robot = robot.clone();
-            pr
+        let at = ValueAt {
+            file,
+            text,
+            robot,
+            name,
         };
-        let Some(spec) = vocab.get(name) else {
-            let hint = vocab
-                .fields
-                .iter()
-                .find(|f| f.name.split('_').next() == name.split('_').next())
-                .map(|f| format!(" (did you mean `{}`?)", f.name))
-                .unwrap_or_default();
-            problems.push(mk(
-                Rule::UnknownField,
-                format!(
-                    "unknown field `{name}`{hint}; fields are listed in dataset/vocabulary.toml"
-                ),
-            ));
-            continue;
-        };
-        let Some(t) = raw.as_table() else {
-            problems.push(mk(
-                Rule::Type,
-                format!("`{name}` must be an inline table like {{ value = ..., source = \"s1\" }}"),
-            ));
-            continue;
-        };
-        for k in t.keys() {
-            if !VALUE_KEYS.contains(&k.as_str()) {
-                problems.push(mk(
-                    Rule::UnknownField,
-                    format!("unknown key `{k}` in `{name}` ({})", VALUE_KEYS.join(", ")),
-                ));
-            }
-        }
-        let sources = source_keys(t.get("source"), &mut |m| problems.push(mk(Rule::Type, m)));
-        let note = t.get("note").and_then(|v| v.as_str()).map(str::to_string);
-        let text_key = |key: &str, problems: &mut Vec<Problem>| match t.get(key) {
-            None => None,
-            Some(toml::Value::String(s)) => Some(s.clone()),
-            Some(other) => {
-                problems.push(mk(
-                    Rule::Type,
-                    format!(
-                        "`{key}` of `{name}` must be a string, found {}",
-                        other.type_str()
-                    ),
-                ));
-                None
-            }
-        };
-        let at = text_key("at", problems);
-        let derivation = text_key("derivation", problems);
-        let derived = match t.get("derived") {
-            None => false,
-            Some(toml::Value::Boolean(b)) => *b,
-            Some(other) => {
-                problems.push(mk(
-                    Rule::Type,
-                    format!(
-                        "`derived` of `{name}` must be true or false, found {}",
-                        other.type_str()
-                    ),
-                ));
-                false
-            }
-        };
-        let mut history = Vec::new();
-        match t.get("history") {
-            None => {}
-            Some(toml::Value::Array(items)) => {
-                for item in items {
-                    let Some(h) = item.as_table() else {
-                        problems.push(mk(
-                            Rule::Type,
-                            format!("each `history` entry of `{name}` must be an inline table {{ value = ..., source = ... }}"),
-                        ));
-                        continue;
-                    };
-                    for k in h.keys() {
-                        if !["value", "min", "max", "source", "note"].contains(&k.as_str()) {
-                            problems.push(mk(
-                                Rule::UnknownField,
-                                format!("unknown key `{k}` in a `history` entry of `{name}` (value, min, max, source, note)"),
-                            ));
-                        }
-                    }
-                    let value = match (h.get("value"), h.get("min"), h.get("max")) {
-                        (Some(v), None, None) => toml_scalar(v),
-                        (None, lo, hi) if lo.is_some() || hi.is_some() => Some(Value::Range {
-                            min: lo.and_then(num),
-                            max: hi.and_then(num),
-                        }),
-                        _ => None,
-                    };
-                    let Some(value) = value else {
-                        problems.push(mk(
-                            Rule::MissingField,
-                            format!(
-                                "a `history` entry of `{name}` needs a `value` (or `min`/`max`)"
-                            ),
-                        ));
-                        continue;
-                    };
-                    let sources =
-                        source_keys(h.get("source"), &mut |m| problems.push(mk(Rule::Type, m)));
-                    history.push(Earlier {
-                        value,
-                        sources,
-                        note: h.get("note").and_then(|v| v.as_str()).map(str::to_string),
-                    });
-                }
-            }
-            Some(other) => problems.push(mk(
-                Rule::Type,
-                format!(
-                    "`history` of `{name}` must be a list of inline tables, found {}",
-                    other.type_str()
-                ),
-            )),
-        }
-        let value = match (t.get("value"), t.get("min"), t.get("max")) {
-            (Some(v), None, None) => match (spec.field_type, v) {
-                (FieldType::Number, v) if num(v).is_some() => num(v).map(Value::Number),
-                (FieldType::Integer, toml::Value::Integer(i)) => Some(Value::Integer(*i)),
-                (FieldType::Text, toml::Value::String(s)) => Some(Value::Text(s.clone())),
-                (FieldType::Bool, toml::Value::Boolean(b)) => Some(Value::Bool(*b)),
-                (ty, v) => {
-                    problems.push(mk(
-                        Rule::Type,
-                        format!(
-                            "`{name}` must be {} , found {} `{v}`",
-                            match ty {
-                                FieldType::Number => "a number",
-                                FieldType::Integer => "an integer",
-                                FieldType::Text => "a string",
-                                FieldType::Bool => "true or false",
-                            },
-                            v.type_str()
-                        ),
-                    ));
-                    None
-                }
-            },
-            (None, lo, hi)
-                if (lo.is_some() || hi.is_some()) && spec.field_type == FieldType::Number =>
-            {
-                let lo_v = lo.and_then(num);
-                let hi_v = hi.and_then(num);
-                if (lo.is_some() && lo_v.is_none()) || (hi.is_some() && hi_v.is_none()) {
-                    problems.push(mk(
-                        Rule::Type,
-                        format!("`{name}` range ends must be numbers"),
-                    ));
-                    None
-                } else {
-                    Some(Value::Range {
-                        min: lo_v,
-                        max: hi_v,
-                    })
-                }
-            }
-            (None, None, None) => {
-                problems.push(mk(Rule::MissingField, format!("`{name}` has no `value`")));
-                None
-            }
-            _ => {
-                problems.push(mk(
-                    Rule::Type,
-                    format!(
-                        "`{name}` takes either `value` or a numeric range `min`/`max`, not both"
-                    ),
-                ));
-                None
-            }
-        };
-        if let Some(value) = value {
-            out.insert(
-                name.clone(),
-                Datum {
-                    value,
-                    sources,
-                    at,
-                    derived,
-                    derivation,
-                    note,
-                    history,
-                },
-            );
+        if let Some(datum) = parse_value(&at, raw, vocab, problems) {
+            out.insert(name.clone(), datum);
         }
     }
     out
+}
+
+/// Where a value sits, to locate its problems.
+struct ValueAt<'a> {
+    file: &'a str,
+    text: &'a str,
+    robot: &'a Option<String>,
+    name: &'a str,
+}
+
+impl ValueAt<'_> {
+    /// An error about this value, with its field name and line.
+    fn problem(&self, rule: Rule, msg: String) -> Problem {
+        let mut pr = Problem::error(self.file, rule, msg)
+            .field(format!("values.{}", self.name))
+            .line(line_of_key(self.text, self.name));
+        pr.robot = self.robot.clone();
+        pr
+    }
+}
+
+/// One entry of `[values]`: checks the field against the vocabulary and reads its keys;
+/// `None` when it has no usable value (the problems say why).
+fn parse_value(
+    at: &ValueAt,
+    raw: &toml::Value,
+    vocab: &Vocabulary,
+    problems: &mut Vec<Problem>,
+) -> Option<Datum> {
+    let name = at.name;
+    let Some(spec) = vocab.get(name) else {
+        let hint = vocab
+            .fields
+            .iter()
+            .find(|f| f.name.split('_').next() == name.split('_').next())
+            .map(|f| format!(" (did you mean `{}`?)", f.name))
+            .unwrap_or_default();
+        problems.push(at.problem(
+            Rule::UnknownField,
+            format!("unknown field `{name}`{hint}; fields are listed in dataset/vocabulary.toml"),
+        ));
+        return None;
+    };
+    let Some(t) = raw.as_table() else {
+        problems.push(at.problem(
+            Rule::Type,
+            format!("`{name}` must be an inline table like {{ value = ..., source = \"s1\" }}"),
+        ));
+        return None;
+    };
+    for k in t.keys() {
+        if !VALUE_KEYS.contains(&k.as_str()) {
+            problems.push(at.problem(
+                Rule::UnknownField,
+                format!("unknown key `{k}` in `{name}` ({})", VALUE_KEYS.join(", ")),
+            ));
+        }
+    }
+    let sources = source_keys(t.get("source"), &mut |m| {
+        problems.push(at.problem(Rule::Type, m))
+    });
+    let note = t.get("note").and_then(|v| v.as_str()).map(str::to_string);
+    let text_key = |key: &str, problems: &mut Vec<Problem>| match t.get(key) {
+        None => None,
+        Some(toml::Value::String(s)) => Some(s.clone()),
+        Some(other) => {
+            problems.push(at.problem(
+                Rule::Type,
+                format!(
+                    "`{key}` of `{name}` must be a string, found {}",
+                    other.type_str()
+                ),
+            ));
+            None
+        }
+    };
+    let at_key = text_key("at", problems);
+    let derivation = text_key("derivation", problems);
+    let derived = match t.get("derived") {
+        None => false,
+        Some(toml::Value::Boolean(b)) => *b,
+        Some(other) => {
+            problems.push(at.problem(
+                Rule::Type,
+                format!(
+                    "`derived` of `{name}` must be true or false, found {}",
+                    other.type_str()
+                ),
+            ));
+            false
+        }
+    };
+    let history = parse_history(at, t.get("history"), problems);
+    let value = parse_value_itself(at, t, spec.field_type, problems)?;
+    Some(Datum {
+        value,
+        sources,
+        at: at_key,
+        derived,
+        derivation,
+        note,
+        history,
+    })
+}
+
+/// A value's `history`: earlier values with their sources.
+fn parse_history(
+    at: &ValueAt,
+    raw: Option<&toml::Value>,
+    problems: &mut Vec<Problem>,
+) -> Vec<Earlier> {
+    let name = at.name;
+    let mut history = Vec::new();
+    match raw {
+        None => {}
+        Some(toml::Value::Array(items)) => {
+            for item in items {
+                if let Some(earlier) = parse_earlier(at, item, problems) {
+                    history.push(earlier);
+                }
+            }
+        }
+        Some(other) => problems.push(at.problem(
+            Rule::Type,
+            format!(
+                "`history` of `{name}` must be a list of inline tables, found {}",
+                other.type_str()
+            ),
+        )),
+    }
+    history
+}
+
+/// One `history` entry.
+fn parse_earlier(at: &ValueAt, item: &toml::Value, problems: &mut Vec<Problem>) -> Option<Earlier> {
+    let name = at.name;
+    let Some(h) = item.as_table() else {
+        problems.push(at.problem(
+            Rule::Type,
+            format!("each `history` entry of `{name}` must be an inline table {{ value = ..., source = ... }}"),
+        ));
+        return None;
+    };
+    for k in h.keys() {
+        if !["value", "min", "max", "source", "note"].contains(&k.as_str()) {
+            problems.push(at.problem(
+                Rule::UnknownField,
+                format!("unknown key `{k}` in a `history` entry of `{name}` (value, min, max, source, note)"),
+            ));
+        }
+    }
+    let value = match (h.get("value"), h.get("min"), h.get("max")) {
+        (Some(v), None, None) => toml_scalar(v),
+        (None, lo, hi) if lo.is_some() || hi.is_some() => Some(Value::Range {
+            min: lo.and_then(num),
+            max: hi.and_then(num),
+        }),
+        _ => None,
+    };
+    let Some(value) = value else {
+        problems.push(at.problem(
+            Rule::MissingField,
+            format!("a `history` entry of `{name}` needs a `value` (or `min`/`max`)"),
+        ));
+        return None;
+    };
+    let sources = source_keys(h.get("source"), &mut |m| {
+        problems.push(at.problem(Rule::Type, m))
+    });
+    Some(Earlier {
+        value,
+        sources,
+        note: h.get("note").and_then(|v| v.as_str()).map(str::to_string),
+    })
+}
+
+/// The value proper: `value` of the field's type, or a numeric range `min`/`max`.
+fn parse_value_itself(
+    at: &ValueAt,
+    t: &toml::Table,
+    field_type: FieldType,
+    problems: &mut Vec<Problem>,
+) -> Option<Value> {
+    let name = at.name;
+    match (t.get("value"), t.get("min"), t.get("max")) {
+        (Some(v), None, None) => match (field_type, v) {
+            (FieldType::Number, v) if num(v).is_some() => num(v).map(Value::Number),
+            (FieldType::Integer, toml::Value::Integer(i)) => Some(Value::Integer(*i)),
+            (FieldType::Text, toml::Value::String(s)) => Some(Value::Text(s.clone())),
+            (FieldType::Bool, toml::Value::Boolean(b)) => Some(Value::Bool(*b)),
+            (ty, v) => {
+                problems.push(at.problem(
+                    Rule::Type,
+                    format!(
+                        "`{name}` must be {} , found {} `{v}`",
+                        match ty {
+                            FieldType::Number => "a number",
+                            FieldType::Integer => "an integer",
+                            FieldType::Text => "a string",
+                            FieldType::Bool => "true or false",
+                        },
+                        v.type_str()
+                    ),
+                ));
+                None
+            }
+        },
+        (None, lo, hi) if (lo.is_some() || hi.is_some()) && field_type == FieldType::Number => {
+            let lo_v = lo.and_then(num);
+            let hi_v = hi.and_then(num);
+            if (lo.is_some() && lo_v.is_none()) || (hi.is_some() && hi_v.is_none()) {
+                problems
+                    .push(at.problem(Rule::Type, format!("`{name}` range ends must be numbers")));
+                None
+            } else {
+                Some(Value::Range {
+                    min: lo_v,
+                    max: hi_v,
+                })
+            }
+        }
+        (None, None, None) => {
+            problems.push(at.problem(Rule::MissingField, format!("`{name}` has no `value`")));
+            None
+        }
+        _ => {
+            problems.push(at.problem(
+                Rule::Type,
+                format!("`{name}` takes either `value` or a numeric range `min`/`max`, not both"),
+            ));
+            None
+        }
+    }
 }
 
 /// Keys a value may carry.

@@ -346,53 +346,136 @@ fn split_references(raw: &str) -> Vec<String> {
 /// (no header, missing columns); everything else is handled and reported.
 pub fn import(bytes: &[u8], file: &str) -> Result<UpstreamImport, DatasetError> {
     let mut quirks = Vec::new();
-    let whole = |kind, raw: &str, handled: &str| Quirk {
-        line: 0,
-        column: None,
-        kind,
-        raw: raw.to_string(),
-        handled: handled.to_string(),
-    };
-    let mut body = bytes;
-    if let Some(rest) = body.strip_prefix(b"\xEF\xBB\xBF".as_slice()) {
-        body = rest;
-        quirks.push(whole("bom", "EF BB BF", "byte-order mark stripped"));
-    }
-    if body.windows(2).any(|w| w == b"\r\n") {
-        quirks.push(whole("crlf", "\\r\\n", "CRLF line ends read as line ends"));
-    }
+    let body = strip_file_quirks(bytes, &mut quirks);
     let mut rdr = csv::ReaderBuilder::new()
         .has_headers(true)
         .flexible(true)
         .from_reader(body);
-    let parse_err = |e: csv::Error| DatasetError::Parse {
+    let headers = read_headers(&mut rdr, file, &mut quirks)?;
+    let mut robots: Vec<Robot> = Vec::new();
+    let mut ledger = Vec::new();
+    for rec in rdr.records() {
+        let rec = rec.map_err(|e| parse_error(file, e))?;
+        let row = Row {
+            headers: &headers,
+            line: rec.position().map(|p| p.line() as usize).unwrap_or(0),
+            rec: &rec,
+        };
+        if rec.iter().all(|c| c.trim().is_empty()) {
+            quirks.push(Quirk {
+                line: row.line,
+                column: None,
+                kind: "blank-row",
+                raw: ",".repeat(rec.len().saturating_sub(1)),
+                handled: "skipped (recorded in the ledger)".into(),
+            });
+            ledger.push(LedgerRow {
+                line: row.line,
+                name: String::new(),
+                record: None,
+                skipped: Some("blank row".into()),
+            });
+            continue;
+        }
+        let robot = import_row(&row, &mut quirks);
+        ledger.push(LedgerRow {
+            line: row.line,
+            name: robot.name.clone(),
+            record: Some(robot.id.clone()),
+            skipped: None,
+        });
+        robots.push(robot);
+    }
+    check_unique_ids(&robots, file)?;
+    Ok(UpstreamImport {
+        sha256: super::release::sha256_hex(bytes),
+        robots,
+        ledger,
+        quirks,
+    })
+}
+
+/// A quirk about one cell (or one row when `column` is `None`).
+fn quirk(
+    line: usize,
+    column: Option<&str>,
+    kind: &'static str,
+    raw: impl Into<String>,
+    handled: impl Into<String>,
+) -> Quirk {
+    Quirk {
+        line,
+        column: column.map(str::to_string),
+        kind,
+        raw: raw.into(),
+        handled: handled.into(),
+    }
+}
+
+fn parse_error(file: &str, e: csv::Error) -> DatasetError {
+    DatasetError::Parse {
         file: file.to_string(),
         line: e.position().map(|p| p.line() as usize),
         message: e.to_string(),
-    };
+    }
+}
+
+/// Whole-file quirks: strips a byte-order mark and notes CRLF line ends (the CSV reader
+/// handles those itself). Returns the body the reader should see.
+fn strip_file_quirks<'a>(bytes: &'a [u8], quirks: &mut Vec<Quirk>) -> &'a [u8] {
+    let mut body = bytes;
+    if let Some(rest) = body.strip_prefix(b"\xEF\xBB\xBF".as_slice()) {
+        body = rest;
+        quirks.push(quirk(
+            0,
+            None,
+            "bom",
+            "EF BB BF",
+            "byte-order mark stripped",
+        ));
+    }
+    if body.windows(2).any(|w| w == b"\r\n") {
+        quirks.push(quirk(
+            0,
+            None,
+            "crlf",
+            "\\r\\n",
+            "CRLF line ends read as line ends",
+        ));
+    }
+    body
+}
+
+/// The header row: notes an empty trailing column and fails when a column the import
+/// reads is missing (then the file is not the survey table).
+fn read_headers(
+    rdr: &mut csv::Reader<&[u8]>,
+    file: &str,
+    quirks: &mut Vec<Quirk>,
+) -> Result<Vec<String>, DatasetError> {
     let headers: Vec<String> = rdr
         .headers()
-        .map_err(parse_err)?
+        .map_err(|e| parse_error(file, e))?
         .iter()
         .map(|h| h.to_string())
         .collect();
     if headers.last().is_some_and(|h| h.is_empty()) {
-        quirks.push(Quirk {
-            line: 1,
-            column: None,
-            kind: "trailing-column",
-            raw: "header ends with `,`".into(),
-            handled: "empty trailing column ignored".into(),
-        });
+        quirks.push(quirk(
+            1,
+            None,
+            "trailing-column",
+            "header ends with `,`",
+            "empty trailing column ignored",
+        ));
     }
-    let col = |name: &str| headers.iter().position(|h| h == name);
+    let has = |name: &str| headers.iter().any(|h| h == name);
     let mut missing: Vec<&str> = COLUMN_MAP
         .iter()
         .map(|(c, _)| *c)
-        .filter(|c| col(c).is_none())
+        .filter(|c| !has(c))
         .collect();
     for c in ["robot_name", "type"] {
-        if col(c).is_none() {
+        if !has(c) {
             missing.push(c);
         }
     }
@@ -405,326 +488,367 @@ pub fn import(bytes: &[u8], file: &str) -> Result<UpstreamImport, DatasetError> 
             ),
         });
     }
+    Ok(headers)
+}
 
-    let mut robots: Vec<Robot> = Vec::new();
-    let mut ledger = Vec::new();
-    for rec in rdr.records() {
-        let rec = rec.map_err(parse_err)?;
-        let line = rec.position().map(|p| p.line() as usize).unwrap_or(0);
-        let get = |name: &str| col(name).and_then(|i| rec.get(i)).unwrap_or("");
-        if rec.iter().all(|c| c.trim().is_empty()) {
-            quirks.push(Quirk {
-                line,
-                column: None,
-                kind: "blank-row",
-                raw: ",".repeat(rec.len().saturating_sub(1)),
-                handled: "skipped (recorded in the ledger)".into(),
+/// One non-blank data row with its physical line.
+struct Row<'a> {
+    headers: &'a [String],
+    rec: &'a csv::StringRecord,
+    line: usize,
+}
+
+impl Row<'_> {
+    /// The raw cell of a column ("" when the row is short).
+    fn get(&self, name: &str) -> &str {
+        self.headers
+            .iter()
+            .position(|h| h == name)
+            .and_then(|i| self.rec.get(i))
+            .unwrap_or("")
+    }
+}
+
+/// One record from one data row.
+fn import_row(row: &Row, quirks: &mut Vec<Quirk>) -> Robot {
+    let line = row.line;
+    let (name, excluded_upstream) = read_name(row, quirks);
+    let id = slug(&name);
+    let (class, raw_type) = read_class(row, quirks);
+    let hybrid = class == RobotClass::Hybrid;
+    let sources = read_sources(row, quirks);
+    let values = read_values(row, class, quirks);
+    let (fit, exclusion) = fit_status(
+        line,
+        &name,
+        &values,
+        excluded_upstream,
+        hybrid.then_some(raw_type.as_str()),
+        quirks,
+    );
+    Robot {
+        id,
+        name,
+        class,
+        fit,
+        exclusion,
+        note: Some(format!(
+            "Imported from the survey table (robot_scaling_dataset.csv, line {line})."
+        )),
+        sources,
+        values,
+    }
+}
+
+/// The robot's name, trimmed and without the upstream exclusion note; the flag says
+/// whether the note was there.
+fn read_name(row: &Row, quirks: &mut Vec<Quirk>) -> (String, bool) {
+    let raw_name = row.get("robot_name");
+    let mut name = raw_name.trim().to_string();
+    if name != raw_name {
+        quirks.push(quirk(
+            row.line,
+            Some("robot_name"),
+            "whitespace",
+            raw_name,
+            format!("name trimmed to `{name}`"),
+        ));
+    }
+    let mut excluded_upstream = false;
+    if let Some(stripped) = name.strip_suffix(NAME_NOTE) {
+        excluded_upstream = true;
+        quirks.push(quirk(
+            row.line,
+            Some("robot_name"),
+            "name-note",
+            name.clone(),
+            "note removed from the name; the record is kept with fit = false and the note as its exclusion reason",
+        ));
+        name = stripped.trim().to_string();
+    }
+    (name, excluded_upstream)
+}
+
+/// Class from the survey's `type`; anything not purely legged becomes a hybrid. Also
+/// returns the trimmed raw type (the hybrid's exclusion reason quotes it).
+fn read_class(row: &Row, quirks: &mut Vec<Quirk>) -> (RobotClass, String) {
+    let raw_type = row.get("type").trim().to_string();
+    let class = match raw_type.as_str() {
+        "lower biped" => RobotClass::LowerBiped,
+        "full biped" => RobotClass::FullBiped,
+        "quadruped" => RobotClass::Quadruped,
+        "hexapod" => RobotClass::Hexapod,
+        "biped" => {
+            quirks.push(quirk(
+                row.line,
+                Some("type"),
+                "ambiguous-class",
+                raw_type.clone(),
+                "`biped` read as full-biped (a humanoid with torso and arms)",
+            ));
+            RobotClass::FullBiped
+        }
+        other => {
+            quirks.push(quirk(
+                row.line,
+                Some("type"),
+                "hybrid-class",
+                other,
+                "class hybrid (not purely legged); kept, not fitted",
+            ));
+            RobotClass::Hybrid
+        }
+    };
+    (class, raw_type)
+}
+
+/// Sources: the survey table itself, then the references it cites for the row.
+fn read_sources(row: &Row, quirks: &mut Vec<Quirk>) -> Vec<Source> {
+    let line = row.line;
+    let mut sources = vec![Source {
+        key: SURVEY_KEY.into(),
+        kind: SourceKind::Dataset,
+        url: Some(SURVEY_URL.into()),
+        title: Some(format!(
+            "Oke et al. 2026, legged-robot survey table robot_scaling_dataset.csv, line {line}"
+        )),
+        note: Some("values transcribed from the survey table, which cites the record's other sources for the row as a whole".into()),
+    }];
+    for (i, r) in split_references(row.get("reference"))
+        .into_iter()
+        .enumerate()
+    {
+        let key = format!("r{}", i + 1);
+        if r.starts_with("http://") || r.starts_with("https://") {
+            sources.push(Source {
+                key,
+                kind: source_kind(&r),
+                url: Some(r),
+                title: None,
+                note: None,
             });
-            ledger.push(LedgerRow {
+        } else {
+            quirks.push(quirk(
                 line,
-                name: String::new(),
-                record: None,
-                skipped: Some("blank row".into()),
+                Some("reference"),
+                "lab-reference",
+                r.clone(),
+                "not a URL: kept as a `lab` source with this title",
+            ));
+            sources.push(Source {
+                key,
+                kind: SourceKind::Lab,
+                url: None,
+                title: Some(r),
+                note: None,
             });
+        }
+    }
+    sources
+}
+
+/// A value transcribed from the survey table.
+fn survey_datum(value: Value, note: Option<String>) -> Datum {
+    Datum {
+        value,
+        sources: vec![SURVEY_KEY.to_string()],
+        note,
+        ..Datum::default()
+    }
+}
+
+/// The row's values: text and numeric columns, a battery description found in the
+/// battery-mass column, and `has_torso` from the biped classes.
+fn read_values(row: &Row, class: RobotClass, quirks: &mut Vec<Quirk>) -> BTreeMap<String, Datum> {
+    let mut values: BTreeMap<String, Datum> = BTreeMap::new();
+    let mut battery_text: Option<String> = None;
+    for (column, field) in COLUMN_MAP {
+        if field.is_empty() {
             continue;
         }
-        let raw_name = get("robot_name");
-        let mut name = raw_name.trim().to_string();
-        if name != raw_name {
-            quirks.push(Quirk {
-                line,
-                column: Some("robot_name".into()),
-                kind: "whitespace",
-                raw: raw_name.into(),
-                handled: format!("name trimmed to `{name}`"),
-            });
-        }
-        let mut excluded_upstream = false;
-        if let Some(stripped) = name.strip_suffix(NAME_NOTE) {
-            excluded_upstream = true;
-            quirks.push(Quirk {
-                line,
-                column: Some("robot_name".into()),
-                kind: "name-note",
-                raw: name.clone(),
-                handled: "note removed from the name; the record is kept with fit = false and the note as its exclusion reason".into(),
-            });
-            name = stripped.trim().to_string();
-        }
-        let id = slug(&name);
-
-        // Class.
-        let raw_type = get("type").trim().to_string();
-        let mut hybrid = false;
-        let class = match raw_type.as_str() {
-            "lower biped" => RobotClass::LowerBiped,
-            "full biped" => RobotClass::FullBiped,
-            "quadruped" => RobotClass::Quadruped,
-            "hexapod" => RobotClass::Hexapod,
-            "biped" => {
-                quirks.push(Quirk {
-                    line,
-                    column: Some("type".into()),
-                    kind: "ambiguous-class",
-                    raw: raw_type.clone(),
-                    handled: "`biped` read as full-biped (a humanoid with torso and arms)".into(),
-                });
-                RobotClass::FullBiped
-            }
-            other => {
-                hybrid = true;
-                quirks.push(Quirk {
-                    line,
-                    column: Some("type".into()),
-                    kind: "hybrid-class",
-                    raw: other.to_string(),
-                    handled: "class hybrid (not purely legged); kept, not fitted".into(),
-                });
-                RobotClass::Hybrid
+        let raw = row.get(column);
+        let datum = if TEXT_FIELDS.contains(&field) {
+            read_text(raw, row.line, column, quirks)
+        } else {
+            match read_number(raw, row.line, column, field, quirks) {
+                Numeric::Datum(d) => Some(d),
+                Numeric::Battery(t) => {
+                    battery_text = Some(t);
+                    None
+                }
+                Numeric::Skip => None,
             }
         };
-
-        // Sources: the survey table itself, then the references it cites for the row.
-        let mut sources = vec![Source {
-            key: SURVEY_KEY.into(),
-            kind: SourceKind::Dataset,
-            url: Some(SURVEY_URL.into()),
-            title: Some(format!(
-                "Oke et al. 2026, legged-robot survey table robot_scaling_dataset.csv, line {line}"
-            )),
-            note: Some("values transcribed from the survey table, which cites the record's other sources for the row as a whole".into()),
-        }];
-        for (i, r) in split_references(get("reference")).into_iter().enumerate() {
-            let key = format!("r{}", i + 1);
-            if r.starts_with("http://") || r.starts_with("https://") {
-                sources.push(Source {
-                    key,
-                    kind: source_kind(&r),
-                    url: Some(r),
-                    title: None,
-                    note: None,
-                });
-            } else {
-                quirks.push(Quirk {
-                    line,
-                    column: Some("reference".into()),
-                    kind: "lab-reference",
-                    raw: r.clone(),
-                    handled: "not a URL: kept as a `lab` source with this title".into(),
-                });
-                sources.push(Source {
-                    key,
-                    kind: SourceKind::Lab,
-                    url: None,
-                    title: Some(r),
-                    note: None,
-                });
-            }
+        if let Some(d) = datum {
+            values.insert(field.into(), d);
         }
-
-        let mut values: BTreeMap<String, Datum> = BTreeMap::new();
-        let survey = || vec![SURVEY_KEY.to_string()];
-        let mut battery_text: Option<String> = None;
-        for (column, field) in COLUMN_MAP {
-            if field.is_empty() {
-                continue;
-            }
-            let raw = get(column);
-            if TEXT_FIELDS.contains(&field) {
-                let t = raw.trim();
-                if t.is_empty() {
-                    continue;
-                }
-                let mut text = t.to_string();
-                if t != raw {
-                    quirks.push(Quirk {
-                        line,
-                        column: Some(column.into()),
-                        kind: "whitespace",
-                        raw: raw.into(),
-                        handled: format!("trimmed to `{t}`"),
-                    });
-                }
-                if let Some(fixed) = fix_mojibake(&text) {
-                    quirks.push(Quirk {
-                        line,
-                        column: Some(column.into()),
-                        kind: "mojibake",
-                        raw: text.clone(),
-                        handled: format!(
-                            "UTF-8 that had been decoded as Mac Roman, repaired to `{fixed}`"
-                        ),
-                    });
-                    text = fixed;
-                }
-                values.insert(
-                    field.into(),
-                    Datum {
-                        value: Value::Text(text),
-                        sources: survey(),
-                        note: None,
-                        ..Datum::default()
-                    },
-                );
-                continue;
-            }
-            let cell = read_numeric(raw, line, column, &mut quirks);
-            let value = match cell {
-                Cell::Empty => continue,
-                Cell::Number(x) if INTEGER_FIELDS.contains(&field) && x.fract() == 0.0 => {
-                    Value::Integer(x as i64)
-                }
-                Cell::Number(x) => Value::Number(x),
-                Cell::Range(lo, hi) => Value::Range { min: lo, max: hi },
-                Cell::Text(t) if field == "battery_mass_kg" => {
-                    quirks.push(Quirk {
-                        line,
-                        column: Some(column.into()),
-                        kind: "text-in-numeric",
-                        raw: t.clone(),
-                        handled:
-                            "a battery description in the battery-mass column: moved to `battery`"
-                                .into(),
-                    });
-                    battery_text = Some(fix_mojibake(&t).unwrap_or(t));
-                    continue;
-                }
-                Cell::Text(t) => {
-                    let nums = numbers_in(&t);
-                    let (value, how) = match nums.as_slice() {
-                        [x] => (
-                            Value::Number(*x),
-                            format!("read as {x}, text kept as the value's note"),
-                        ),
-                        [a, b, ..] => (
-                            Value::Range {
-                                min: Some(a.min(*b)),
-                                max: Some(a.max(*b)),
-                            },
-                            format!(
-                                "read as range {}..{}, text kept as the value's note",
-                                a.min(*b),
-                                a.max(*b)
-                            ),
-                        ),
-                        [] => {
-                            quirks.push(Quirk {
-                                line,
-                                column: Some(column.into()),
-                                kind: "text-in-numeric",
-                                raw: t.clone(),
-                                handled:
-                                    "no number in it: dropped from values, kept in the record note"
-                                        .into(),
-                            });
-                            continue;
-                        }
-                    };
-                    quirks.push(Quirk {
-                        line,
-                        column: Some(column.into()),
-                        kind: "text-in-numeric",
-                        raw: t.clone(),
-                        handled: how,
-                    });
-                    values.insert(
-                        field.into(),
-                        Datum {
-                            value,
-                            sources: survey(),
-                            note: Some(format!("upstream text: {t}")),
-                            ..Datum::default()
-                        },
-                    );
-                    continue;
-                }
-            };
-            values.insert(
-                field.into(),
-                Datum {
-                    value,
-                    sources: survey(),
-                    note: None,
-                    ..Datum::default()
-                },
-            );
-        }
-        if let Some(t) = battery_text {
-            values.insert(
-                "battery".into(),
-                Datum {
-                    value: Value::Text(t),
-                    sources: survey(),
-                    note: None,
-                    ..Datum::default()
-                },
-            );
-        }
-        if matches!(class, RobotClass::LowerBiped | RobotClass::FullBiped) {
-            values.insert(
-                "has_torso".into(),
-                Datum {
-                    value: Value::Bool(class == RobotClass::FullBiped),
-                    sources: survey(),
-                    note: Some("from the survey's lower/full biped classification".into()),
-                    ..Datum::default()
-                },
-            );
-        }
-
-        // Fit status: the upstream note, hybrids, and rows without the fitted values.
-        let missing: Vec<&str> = ["leg_length_m", "body_length_m", "mass_kg"]
-            .into_iter()
-            .filter(|f| values.get(*f).and_then(|d| d.value.as_f64()).is_none())
-            .collect();
-        let mut reasons = Vec::new();
-        if excluded_upstream {
-            reasons.push("marked \"(excluded from power laws)\" in the survey table".to_string());
-        }
-        if hybrid {
-            reasons.push(format!("not purely legged (survey type \"{raw_type}\")"));
-        }
-        if !missing.is_empty() {
-            reasons.push(format!("no {} reported", missing.join(", no ")));
-            if !excluded_upstream && !hybrid {
-                quirks.push(Quirk {
-                    line,
-                    column: None,
-                    kind: "missing-leg-length",
-                    raw: name.clone(),
-                    handled: format!("not marked excluded upstream but has no {}: kept with fit = false (the paper's counts exclude it)", missing.join(", ")),
-                });
-            }
-        }
-        let fit = reasons.is_empty();
-        let exclusion = (!fit).then(|| {
-            let mut r = reasons.join("; ");
-            if let Some(first) = r.get_mut(0..1) {
-                first.make_ascii_uppercase();
-            }
-            r
-        });
-        ledger.push(LedgerRow {
-            line,
-            name: name.clone(),
-            record: Some(id.clone()),
-            skipped: None,
-        });
-        robots.push(Robot {
-            id,
-            name,
-            class,
-            fit,
-            exclusion,
-            note: Some(format!(
-                "Imported from the survey table (robot_scaling_dataset.csv, line {line})."
-            )),
-            sources,
-            values,
-        });
     }
+    if let Some(t) = battery_text {
+        values.insert("battery".into(), survey_datum(Value::Text(t), None));
+    }
+    if matches!(class, RobotClass::LowerBiped | RobotClass::FullBiped) {
+        values.insert(
+            "has_torso".into(),
+            survey_datum(
+                Value::Bool(class == RobotClass::FullBiped),
+                Some("from the survey's lower/full biped classification".into()),
+            ),
+        );
+    }
+    values
+}
+
+/// A text column: trimmed and repaired from Mac Roman mojibake; `None` when empty.
+fn read_text(raw: &str, line: usize, column: &str, quirks: &mut Vec<Quirk>) -> Option<Datum> {
+    let t = raw.trim();
+    if t.is_empty() {
+        return None;
+    }
+    let mut text = t.to_string();
+    if t != raw {
+        quirks.push(quirk(
+            line,
+            Some(column),
+            "whitespace",
+            raw,
+            format!("trimmed to `{t}`"),
+        ));
+    }
+    if let Some(fixed) = fix_mojibake(&text) {
+        quirks.push(quirk(
+            line,
+            Some(column),
+            "mojibake",
+            text.clone(),
+            format!("UTF-8 that had been decoded as Mac Roman, repaired to `{fixed}`"),
+        ));
+        text = fixed;
+    }
+    Some(survey_datum(Value::Text(text), None))
+}
+
+/// What a numeric column gives.
+enum Numeric {
+    Datum(Datum),
+    /// A battery description found in the battery-mass column.
+    Battery(String),
+    Skip,
+}
+
+/// A numeric column: numbers, ranges, and text with numbers in it (read, the text kept
+/// as the value's note).
+fn read_number(
+    raw: &str,
+    line: usize,
+    column: &str,
+    field: &str,
+    quirks: &mut Vec<Quirk>,
+) -> Numeric {
+    let value = match read_numeric(raw, line, column, quirks) {
+        Cell::Empty => return Numeric::Skip,
+        Cell::Number(x) if INTEGER_FIELDS.contains(&field) && x.fract() == 0.0 => {
+            Value::Integer(x as i64)
+        }
+        Cell::Number(x) => Value::Number(x),
+        Cell::Range(lo, hi) => Value::Range { min: lo, max: hi },
+        Cell::Text(t) if field == "battery_mass_kg" => {
+            quirks.push(quirk(
+                line,
+                Some(column),
+                "text-in-numeric",
+                t.clone(),
+                "a battery description in the battery-mass column: moved to `battery`",
+            ));
+            return Numeric::Battery(fix_mojibake(&t).unwrap_or(t));
+        }
+        Cell::Text(t) => return read_number_in_text(t, line, column, quirks),
+    };
+    Numeric::Datum(survey_datum(value, None))
+}
+
+/// Text in a numeric column: one number is read as the value, two or more as a range,
+/// none drops the cell (the text stays in the record note).
+fn read_number_in_text(t: String, line: usize, column: &str, quirks: &mut Vec<Quirk>) -> Numeric {
+    let nums = numbers_in(&t);
+    let (value, how) = match nums.as_slice() {
+        [x] => (
+            Value::Number(*x),
+            format!("read as {x}, text kept as the value's note"),
+        ),
+        [a, b, ..] => (
+            Value::Range {
+                min: Some(a.min(*b)),
+                max: Some(a.max(*b)),
+            },
+            format!(
+                "read as range {}..{}, text kept as the value's note",
+                a.min(*b),
+                a.max(*b)
+            ),
+        ),
+        [] => {
+            quirks.push(quirk(
+                line,
+                Some(column),
+                "text-in-numeric",
+                t,
+                "no number in it: dropped from values, kept in the record note",
+            ));
+            return Numeric::Skip;
+        }
+    };
+    quirks.push(quirk(line, Some(column), "text-in-numeric", t.clone(), how));
+    Numeric::Datum(survey_datum(value, Some(format!("upstream text: {t}"))))
+}
+
+/// Fit status: the upstream note, hybrids (`hybrid_type` is the survey type), and rows
+/// without the fitted values. Returns `fit` and the exclusion reason.
+fn fit_status(
+    line: usize,
+    name: &str,
+    values: &BTreeMap<String, Datum>,
+    excluded_upstream: bool,
+    hybrid_type: Option<&str>,
+    quirks: &mut Vec<Quirk>,
+) -> (bool, Option<String>) {
+    let missing: Vec<&str> = ["leg_length_m", "body_length_m", "mass_kg"]
+        .into_iter()
+        .filter(|f| values.get(*f).and_then(|d| d.value.as_f64()).is_none())
+        .collect();
+    let mut reasons = Vec::new();
+    if excluded_upstream {
+        reasons.push("marked \"(excluded from power laws)\" in the survey table".to_string());
+    }
+    if let Some(raw_type) = hybrid_type {
+        reasons.push(format!("not purely legged (survey type \"{raw_type}\")"));
+    }
+    if !missing.is_empty() {
+        reasons.push(format!("no {} reported", missing.join(", no ")));
+        if !excluded_upstream && hybrid_type.is_none() {
+            quirks.push(quirk(
+                line,
+                None,
+                "missing-leg-length",
+                name,
+                format!("not marked excluded upstream but has no {}: kept with fit = false (the paper's counts exclude it)", missing.join(", ")),
+            ));
+        }
+    }
+    let fit = reasons.is_empty();
+    let exclusion = (!fit).then(|| {
+        let mut r = reasons.join("; ");
+        if let Some(first) = r.get_mut(0..1) {
+            first.make_ascii_uppercase();
+        }
+        r
+    });
+    (fit, exclusion)
+}
+
+/// Two rows must not give the same record id.
+fn check_unique_ids(robots: &[Robot], file: &str) -> Result<(), DatasetError> {
     let mut seen = BTreeMap::new();
-    for r in &robots {
+    for r in robots {
         if let Some(prev) = seen.insert(r.id.clone(), r.name.clone()) {
             return Err(DatasetError::Invalid {
                 file: file.to_string(),
@@ -735,12 +859,7 @@ pub fn import(bytes: &[u8], file: &str) -> Result<UpstreamImport, DatasetError> 
             });
         }
     }
-    Ok(UpstreamImport {
-        sha256: super::release::sha256_hex(bytes),
-        robots,
-        ledger,
-        quirks,
-    })
+    Ok(())
 }
 
 /// Outcome of `import-upstream --check`.

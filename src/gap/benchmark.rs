@@ -391,9 +391,6 @@ pub fn plan(
         .iter()
         .map(|e| e.name.clone())
         .collect();
-    let mut suites = Vec::new();
-    let mut cases = Vec::new();
-    let mut thr_table: BTreeMap<String, Vec<(String, Option<f64>)>> = BTreeMap::new();
 
     progress("default conditions");
     let main = Suite::new(
@@ -404,333 +401,24 @@ pub fn plan(
             trials: default_conditions(&opts.design)?,
         },
     )?;
-    let nominal = main
-        .cache
-        .get(&main.conditions, lib, &ModelSetting::nominal(), &|| {})?;
-    let mut noise_for_thr: Vec<f64> = opts.noise_levels.clone();
-    noise_for_thr.push(opts.pair_noise);
-    noise_for_thr.sort_by(f64::total_cmp);
-    noise_for_thr.dedup();
-    let mut thr: BTreeMap<String, BTreeMap<String, f64>> = BTreeMap::new();
-    let mut thr_off: BTreeMap<String, BTreeMap<String, f64>> = BTreeMap::new();
-    for &noise in &noise_for_thr {
-        progress(&format!("thresholds at {} % noise", noise * 100.0));
-        if opts.calibration_off_noise == Some(noise) {
-            let off = thresholds(
-                &main.base,
-                &main.conditions,
-                &nominal,
-                lib,
-                noise,
-                &opts.effects,
-                false,
-                &main.cache,
-            )?;
-            thr_off.insert(
-                format!("{noise}"),
-                off.iter()
-                    .filter_map(|i| i.identification_threshold.map(|t| (i.effect.clone(), t)))
-                    .collect(),
-            );
-        }
-        let mut ids = thresholds(
-            &main.base,
-            &main.conditions,
-            &nominal,
-            lib,
-            noise,
-            &opts.effects,
-            true,
-            &main.cache,
-        )?;
-        // Effects the design calibrates as a parameter have no effect knob: their threshold
-        // against the other effects (calibration off).
-        let missing: Vec<String> = effect_names
-            .iter()
-            .filter(|e| !ids.iter().any(|i| &i.effect == *e))
-            .cloned()
-            .collect();
-        if !missing.is_empty() {
-            let off = thresholds(
-                &main.base,
-                &main.conditions,
-                &nominal,
-                lib,
-                noise,
-                &missing,
-                false,
-                &main.cache,
-            )?;
-            ids.extend(off);
-            ids.sort_by(|a, b| a.effect.cmp(&b.effect));
-        }
-        let key = format!("{noise}");
-        // An effect not identifiable within its range has no threshold: no case of it is
-        // made (the report lists it), since "k times the threshold" does not exist.
-        thr_table.insert(
-            key.clone(),
-            ids.iter()
-                .map(|i| (i.effect.clone(), i.identification_threshold))
-                .collect(),
-        );
-        thr.insert(
-            key,
-            ids.iter()
-                .filter_map(|i| i.identification_threshold.map(|t| (i.effect.clone(), t)))
-                .collect(),
-        );
-    }
-    let thr_of = |noise: f64, e: &str| -> Option<f64> {
-        thr.get(&format!("{noise}")).and_then(|m| m.get(e)).copied()
+    let thr = Thresholds::of_main(lib, opts, &main, &effect_names, progress)?;
+    let mut planner = Planner {
+        lib,
+        opts,
+        design: &design,
+        effect_names: &effect_names,
+        thr: &thr,
+        cases: Vec::new(),
     };
-    let thr_off_of = |noise: f64, e: &str| -> Option<f64> {
-        thr_off
-            .get(&format!("{noise}"))
-            .and_then(|m| m.get(e))
-            .copied()
-    };
-    let sim_case = |suite: &str,
-                    kind: &str,
-                    noise: f64,
-                    seed: u64,
-                    calibrate: bool,
-                    multiple: Option<f64>,
-                    params: Vec<(String, f64)>,
-                    effects: Vec<(String, f64)>| {
-        let truth = Truth::Sim { params, effects };
-        let key = format!(
-            "{suite}/{kind}/{}/{}/n{noise}/s{seed}{}",
-            match &truth {
-                Truth::Sim { effects, .. } => pairs(effects),
-                Truth::Drake { .. } => String::new(),
-            },
-            match &truth {
-                Truth::Sim { params, .. } => pairs(params),
-                Truth::Drake { .. } => String::new(),
-            },
-            if calibrate { "" } else { "/nocal" }
-        );
-        CaseSpec {
-            key,
-            suite: suite.into(),
-            kind: kind.into(),
-            noise,
-            seed,
-            calibrate,
-            multiple,
-            truth,
-        }
-    };
-    // Nulls.
-    for &noise in &opts.noise_levels {
-        for seed in 0..opts.null_cases {
-            cases.push(sim_case(
-                "main",
-                "null",
-                noise,
-                seed,
-                true,
-                None,
-                vec![],
-                vec![],
-            ));
-        }
-    }
-    // Single effects.
-    let singles = |noise: f64, calibrate: bool, cases: &mut Vec<CaseSpec>| {
-        for e in &effect_names {
-            let t = if calibrate {
-                thr_of(noise, e)
-            } else {
-                thr_off_of(noise, e)
-            };
-            let Some(t) = t else { continue };
-            for &k in &opts.multiples {
-                let mag = magnitude_at(lib, &design, e, t, k);
-                for seed in 0..opts.seeds {
-                    cases.push(sim_case(
-                        "main",
-                        "effect",
-                        noise,
-                        seed,
-                        calibrate,
-                        Some(k),
-                        vec![],
-                        vec![(e.clone(), mag)],
-                    ));
-                }
-            }
-        }
-    };
-    for &noise in &opts.noise_levels {
-        singles(noise, true, &mut cases);
-    }
-    if let Some(noise) = opts.calibration_off_noise {
-        singles(noise, false, &mut cases);
-    }
-    // Pairs.
-    for (i, a) in effect_names.iter().enumerate() {
-        for b in &effect_names[i + 1..] {
-            let (Some(ta), Some(tb)) = (thr_of(opts.pair_noise, a), thr_of(opts.pair_noise, b))
-            else {
-                continue;
-            };
-            let mag = |e: &str| {
-                magnitude_at(
-                    lib,
-                    &design,
-                    e,
-                    if e == a { ta } else { tb },
-                    opts.pair_multiple,
-                )
-            };
-            for seed in 0..opts.seeds {
-                cases.push(sim_case(
-                    "main",
-                    "pair",
-                    opts.pair_noise,
-                    seed,
-                    true,
-                    Some(opts.pair_multiple),
-                    vec![],
-                    vec![(a.clone(), mag(a)), (b.clone(), mag(b))],
-                ));
-            }
-        }
-    }
-    // Nominal-parameter errors.
-    for params in &opts.parameter_errors {
-        for &noise in &opts.parameter_noise {
-            for seed in 0..opts.seeds {
-                cases.push(sim_case(
-                    "main",
-                    "parameter",
-                    noise,
-                    seed,
-                    true,
-                    None,
-                    params.clone(),
-                    vec![],
-                ));
-            }
-        }
-    }
-    suites.push(main);
-
-    // One robot.
+    planner.main_cases();
+    let mut suites = vec![main];
     if opts.one_robot_null_cases > 0 {
-        let one = Suite::new(
-            "one-robot",
-            TrialSet {
-                origin: format!("one-robot conditions of {}", opts.design),
-                base_dir: PathBuf::from("."),
-                trials: one_robot_conditions(&opts.design)?,
-            },
-        )?;
-        let noise = 0.05;
-        for seed in 0..opts.one_robot_null_cases {
-            cases.push(sim_case(
-                "one-robot",
-                "null",
-                noise,
-                seed,
-                true,
-                None,
-                vec![],
-                vec![],
-            ));
-        }
-        for e in &effect_names {
-            let Some(t) = thr_of(noise, e) else { continue };
-            let mag = magnitude_at(lib, &design, e, t, 2.0);
-            for seed in 0..opts.seeds {
-                cases.push(sim_case(
-                    "one-robot",
-                    "effect",
-                    noise,
-                    seed,
-                    true,
-                    Some(2.0),
-                    vec![],
-                    vec![(e.clone(), mag)],
-                ));
-            }
-        }
-        for params in &opts.parameter_errors {
-            for seed in 0..opts.seeds {
-                cases.push(sim_case(
-                    "one-robot",
-                    "parameter",
-                    noise,
-                    seed,
-                    true,
-                    None,
-                    params.clone(),
-                    vec![],
-                ));
-            }
-        }
-        suites.push(one);
+        suites.push(planner.one_robot_cases()?);
     }
-
-    // Drake.
+    let mut cases = planner.cases;
     let mut drake = BTreeMap::new();
     if let Some(dir) = &opts.drake_dir {
-        let mut files: Vec<PathBuf> = std::fs::read_dir(dir)
-            .map_err(|source| GapError::Read {
-                path: dir.clone(),
-                source,
-            })?
-            .filter_map(|e| e.ok().map(|e| e.path()))
-            .filter(|p| {
-                p.file_name()
-                    .and_then(|f| f.to_str())
-                    .is_some_and(|f| f.starts_with("trials-") && f.ends_with(".csv"))
-            })
-            .collect();
-        files.sort();
-        for f in files {
-            let set = TrialSet::read(&f)?;
-            let name = f
-                .file_stem()
-                .and_then(|s| s.to_str())
-                .unwrap_or("")
-                .to_string();
-            let effect = name
-                .strip_prefix("trials-")
-                .and_then(|rest| rest.rsplit_once('-'))
-                .and_then(|(e, v)| Some((e.to_string(), v.parse::<f64>().ok()?)));
-            // One suite serves every Drake file: its conditions must be the first file's.
-            if let Some((first, _)) = drake.values().next()
-                && !same_conditions(first, &set)
-            {
-                return Err(GapError::File {
-                    path: f.display().to_string(),
-                    message: format!(
-                        "its conditions differ from those of the other Drake trials files in {}",
-                        dir.display()
-                    ),
-                });
-            }
-            let truth: Vec<SimMetrics> = set.trials.iter().map(SimMetrics::measured_by).collect();
-            for seed in 0..opts.drake_seeds {
-                let key = format!("drake/{name}/n{}/s{seed}", opts.pair_noise);
-                cases.push(CaseSpec {
-                    key,
-                    suite: "drake".into(),
-                    kind: "drake".into(),
-                    noise: opts.pair_noise,
-                    seed,
-                    calibrate: true,
-                    multiple: None,
-                    truth: Truth::Drake {
-                        file: name.clone(),
-                        effect: effect.clone(),
-                    },
-                });
-            }
-            drake.insert(name, (set, truth));
-        }
+        drake = drake_cases(opts, dir, &mut cases)?;
         if let Some((set, _)) = drake.values().next() {
             let mut base = set.clone();
             for t in base.trials.iter_mut() {
@@ -745,10 +433,370 @@ pub fn plan(
     cases.retain(|c| seen.insert(c.key.clone()));
     Ok(Plan {
         cases,
-        thresholds: thr_table,
+        thresholds: thr.table,
         suites,
         drake,
     })
+}
+
+/// The main suite's identification thresholds per noise level (keyed by `{noise}`).
+struct Thresholds {
+    /// Every effect, `None` when not identifiable within its range (for the report).
+    table: BTreeMap<String, Vec<(String, Option<f64>)>>,
+    /// With calibration.
+    on: BTreeMap<String, BTreeMap<String, f64>>,
+    /// Calibration off (only at `calibration_off_noise`).
+    off: BTreeMap<String, BTreeMap<String, f64>>,
+}
+
+impl Thresholds {
+    /// The thresholds at every noise level of the null/single cases and at the pair noise.
+    fn of_main(
+        lib: &EffectLibrary,
+        opts: &BenchmarkOptions,
+        main: &Suite,
+        effect_names: &[String],
+        progress: &(dyn Fn(&str) + Sync),
+    ) -> Result<Thresholds, GapError> {
+        let nominal = main
+            .cache
+            .get(&main.conditions, lib, &ModelSetting::nominal(), &|| {})?;
+        let mut noise_for_thr: Vec<f64> = opts.noise_levels.clone();
+        noise_for_thr.push(opts.pair_noise);
+        noise_for_thr.sort_by(f64::total_cmp);
+        noise_for_thr.dedup();
+        let mut out = Thresholds {
+            table: BTreeMap::new(),
+            on: BTreeMap::new(),
+            off: BTreeMap::new(),
+        };
+        let at = |noise: f64, effects: &[String], calibrate: bool| {
+            thresholds(
+                &main.base,
+                &main.conditions,
+                &nominal,
+                lib,
+                noise,
+                effects,
+                calibrate,
+                &main.cache,
+            )
+        };
+        let named = |ids: &[Identifiability]| -> BTreeMap<String, f64> {
+            ids.iter()
+                .filter_map(|i| i.identification_threshold.map(|t| (i.effect.clone(), t)))
+                .collect()
+        };
+        for &noise in &noise_for_thr {
+            progress(&format!("thresholds at {} % noise", noise * 100.0));
+            if opts.calibration_off_noise == Some(noise) {
+                let off = at(noise, &opts.effects, false)?;
+                out.off.insert(format!("{noise}"), named(&off));
+            }
+            let mut ids = at(noise, &opts.effects, true)?;
+            // Effects the design calibrates as a parameter have no effect knob: their
+            // threshold against the other effects (calibration off).
+            let missing: Vec<String> = effect_names
+                .iter()
+                .filter(|e| !ids.iter().any(|i| &i.effect == *e))
+                .cloned()
+                .collect();
+            if !missing.is_empty() {
+                let off = at(noise, &missing, false)?;
+                ids.extend(off);
+                ids.sort_by(|a, b| a.effect.cmp(&b.effect));
+            }
+            let key = format!("{noise}");
+            // An effect not identifiable within its range has no threshold: no case of it
+            // is made (the report lists it), since "k times the threshold" does not exist.
+            out.table.insert(
+                key.clone(),
+                ids.iter()
+                    .map(|i| (i.effect.clone(), i.identification_threshold))
+                    .collect(),
+            );
+            out.on.insert(key, named(&ids));
+        }
+        Ok(out)
+    }
+
+    /// An effect's threshold at a noise level, with calibration on or off.
+    fn get(&self, noise: f64, e: &str, calibrate: bool) -> Option<f64> {
+        let map = if calibrate { &self.on } else { &self.off };
+        map.get(&format!("{noise}")).and_then(|m| m.get(e)).copied()
+    }
+}
+
+/// A case whose trials the simulator makes; its key is the truth.
+#[allow(clippy::too_many_arguments)]
+fn sim_case(
+    suite: &str,
+    kind: &str,
+    noise: f64,
+    seed: u64,
+    calibrate: bool,
+    multiple: Option<f64>,
+    params: Vec<(String, f64)>,
+    effects: Vec<(String, f64)>,
+) -> CaseSpec {
+    let key = format!(
+        "{suite}/{kind}/{}/{}/n{noise}/s{seed}{}",
+        pairs(&effects),
+        pairs(&params),
+        if calibrate { "" } else { "/nocal" }
+    );
+    CaseSpec {
+        key,
+        suite: suite.into(),
+        kind: kind.into(),
+        noise,
+        seed,
+        calibrate,
+        multiple,
+        truth: Truth::Sim { params, effects },
+    }
+}
+
+/// Makes the simulated cases, in the plan's order.
+struct Planner<'a> {
+    lib: &'a EffectLibrary,
+    opts: &'a BenchmarkOptions,
+    design: &'a Design,
+    effect_names: &'a [String],
+    thr: &'a Thresholds,
+    cases: Vec<CaseSpec>,
+}
+
+impl Planner<'_> {
+    /// The main suite: nulls, single effects (and again with calibration off), pairs,
+    /// nominal-parameter errors.
+    fn main_cases(&mut self) {
+        let opts = self.opts;
+        for &noise in &opts.noise_levels {
+            for seed in 0..opts.null_cases {
+                self.cases.push(sim_case(
+                    "main",
+                    "null",
+                    noise,
+                    seed,
+                    true,
+                    None,
+                    vec![],
+                    vec![],
+                ));
+            }
+        }
+        for &noise in &opts.noise_levels {
+            self.singles(noise, true);
+        }
+        if let Some(noise) = opts.calibration_off_noise {
+            self.singles(noise, false);
+        }
+        self.pairs();
+        for params in &opts.parameter_errors {
+            for &noise in &opts.parameter_noise {
+                for seed in 0..opts.seeds {
+                    self.cases.push(sim_case(
+                        "main",
+                        "parameter",
+                        noise,
+                        seed,
+                        true,
+                        None,
+                        params.clone(),
+                        vec![],
+                    ));
+                }
+            }
+        }
+    }
+
+    /// Every effect alone at each multiple of its threshold.
+    fn singles(&mut self, noise: f64, calibrate: bool) {
+        for e in self.effect_names {
+            let Some(t) = self.thr.get(noise, e, calibrate) else {
+                continue;
+            };
+            for &k in &self.opts.multiples {
+                let mag = magnitude_at(self.lib, self.design, e, t, k);
+                for seed in 0..self.opts.seeds {
+                    self.cases.push(sim_case(
+                        "main",
+                        "effect",
+                        noise,
+                        seed,
+                        calibrate,
+                        Some(k),
+                        vec![],
+                        vec![(e.clone(), mag)],
+                    ));
+                }
+            }
+        }
+    }
+
+    /// Every pair of effects, each at the pair multiple of its threshold.
+    fn pairs(&mut self) {
+        let opts = self.opts;
+        for (i, a) in self.effect_names.iter().enumerate() {
+            for b in &self.effect_names[i + 1..] {
+                let (Some(ta), Some(tb)) = (
+                    self.thr.get(opts.pair_noise, a, true),
+                    self.thr.get(opts.pair_noise, b, true),
+                ) else {
+                    continue;
+                };
+                let mag = |e: &str| {
+                    magnitude_at(
+                        self.lib,
+                        self.design,
+                        e,
+                        if e == a { ta } else { tb },
+                        opts.pair_multiple,
+                    )
+                };
+                let effects = vec![(a.clone(), mag(a)), (b.clone(), mag(b))];
+                for seed in 0..opts.seeds {
+                    self.cases.push(sim_case(
+                        "main",
+                        "pair",
+                        opts.pair_noise,
+                        seed,
+                        true,
+                        Some(opts.pair_multiple),
+                        vec![],
+                        effects.clone(),
+                    ));
+                }
+            }
+        }
+    }
+
+    /// The one-robot suite at 5 % noise: nulls, single effects at 2× their (main-suite)
+    /// threshold, nominal-parameter errors.
+    fn one_robot_cases(&mut self) -> Result<Suite, GapError> {
+        let opts = self.opts;
+        let one = Suite::new(
+            "one-robot",
+            TrialSet {
+                origin: format!("one-robot conditions of {}", opts.design),
+                base_dir: PathBuf::from("."),
+                trials: one_robot_conditions(&opts.design)?,
+            },
+        )?;
+        let noise = 0.05;
+        for seed in 0..opts.one_robot_null_cases {
+            self.cases.push(sim_case(
+                "one-robot",
+                "null",
+                noise,
+                seed,
+                true,
+                None,
+                vec![],
+                vec![],
+            ));
+        }
+        for e in self.effect_names {
+            let Some(t) = self.thr.get(noise, e, true) else {
+                continue;
+            };
+            let mag = magnitude_at(self.lib, self.design, e, t, 2.0);
+            for seed in 0..opts.seeds {
+                self.cases.push(sim_case(
+                    "one-robot",
+                    "effect",
+                    noise,
+                    seed,
+                    true,
+                    Some(2.0),
+                    vec![],
+                    vec![(e.clone(), mag)],
+                ));
+            }
+        }
+        for params in &opts.parameter_errors {
+            for seed in 0..opts.seeds {
+                self.cases.push(sim_case(
+                    "one-robot",
+                    "parameter",
+                    noise,
+                    seed,
+                    true,
+                    None,
+                    params.clone(),
+                    vec![],
+                ));
+            }
+        }
+        Ok(one)
+    }
+}
+
+/// The Drake cases: every `trials-*.csv` of `dir` (named `trials-<effect>-<value>` when
+/// Drake added an effect), `drake_seeds` noisy copies each. Returns the truths by file.
+fn drake_cases(
+    opts: &BenchmarkOptions,
+    dir: &Path,
+    cases: &mut Vec<CaseSpec>,
+) -> Result<BTreeMap<String, (TrialSet, Vec<SimMetrics>)>, GapError> {
+    let mut drake: BTreeMap<String, (TrialSet, Vec<SimMetrics>)> = BTreeMap::new();
+    let mut files: Vec<PathBuf> = std::fs::read_dir(dir)
+        .map_err(|source| GapError::Read {
+            path: dir.to_path_buf(),
+            source,
+        })?
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .filter(|p| {
+            p.file_name()
+                .and_then(|f| f.to_str())
+                .is_some_and(|f| f.starts_with("trials-") && f.ends_with(".csv"))
+        })
+        .collect();
+    files.sort();
+    for f in files {
+        let set = TrialSet::read(&f)?;
+        let name = f
+            .file_stem()
+            .and_then(|s| s.to_str())
+            .unwrap_or("")
+            .to_string();
+        let effect = name
+            .strip_prefix("trials-")
+            .and_then(|rest| rest.rsplit_once('-'))
+            .and_then(|(e, v)| Some((e.to_string(), v.parse::<f64>().ok()?)));
+        // One suite serves every Drake file: its conditions must be the first file's.
+        if let Some((first, _)) = drake.values().next()
+            && !same_conditions(first, &set)
+        {
+            return Err(GapError::File {
+                path: f.display().to_string(),
+                message: format!(
+                    "its conditions differ from those of the other Drake trials files in {}",
+                    dir.display()
+                ),
+            });
+        }
+        let truth: Vec<SimMetrics> = set.trials.iter().map(SimMetrics::measured_by).collect();
+        for seed in 0..opts.drake_seeds {
+            let key = format!("drake/{name}/n{}/s{seed}", opts.pair_noise);
+            cases.push(CaseSpec {
+                key,
+                suite: "drake".into(),
+                kind: "drake".into(),
+                noise: opts.pair_noise,
+                seed,
+                calibrate: true,
+                multiple: None,
+                truth: Truth::Drake {
+                    file: name.clone(),
+                    effect: effect.clone(),
+                },
+            });
+        }
+        drake.insert(name, (set, truth));
+    }
+    Ok(drake)
 }
 
 /// The specification line of a benchmark's points file.
@@ -1076,9 +1124,31 @@ pub fn summarize(
     opts: &BenchmarkOptions,
     thresholds: BTreeMap<String, Vec<(String, Option<f64>)>>,
 ) -> BenchmarkSummary {
-    let design = Design::resolve(&opts.design).ok();
-    let aliases: BTreeMap<String, String> = lib
-        .effects
+    let aliases = effect_aliases(lib, &opts.design);
+    let mut noise_levels: Vec<f64> = rows.iter().map(|r| r.noise).collect();
+    noise_levels.sort_by(f64::total_cmp);
+    noise_levels.dedup();
+    let mut scores = Vec::new();
+    null_scores(rows, &noise_levels, &mut scores);
+    single_effect_scores(rows, &noise_levels, &aliases, &mut scores);
+    pair_scores(rows, &aliases, &mut scores);
+    parameter_scores(rows, &mut scores);
+    drake_scores(rows, &aliases, &mut scores);
+    scores.push(coverage_score(rows, &aliases));
+    BenchmarkSummary {
+        design: opts.design.clone(),
+        cases: rows.len(),
+        scores,
+        confusions: confusions(rows, &noise_levels),
+        thresholds,
+    }
+}
+
+/// Effects that stand for a declared uncertain parameter of the design (effect → path):
+/// naming either is naming the truth.
+fn effect_aliases(lib: &EffectLibrary, design: &str) -> BTreeMap<String, String> {
+    let design = Design::resolve(design).ok();
+    lib.effects
         .iter()
         .filter_map(|e| {
             let f = e.replaces.clone()?;
@@ -1087,16 +1157,36 @@ pub fn summarize(
                 .is_some_and(|d| d.uncertain.iter().any(|u| u.path == f))
                 .then(|| (e.name.clone(), f))
         })
-        .collect();
-    let mut scores = Vec::new();
-    let any_named = |r: &CaseRow| !r.named_effects.is_empty() || !r.named_params.is_empty();
-    let effect_named = |r: &CaseRow| !r.named_effects.is_empty();
-    // Nulls.
-    let mut noise_levels: Vec<f64> = rows.iter().map(|r| r.noise).collect();
-    noise_levels.sort_by(f64::total_cmp);
-    noise_levels.dedup();
+        .collect()
+}
+
+fn any_named(r: &CaseRow) -> bool {
+    !r.named_effects.is_empty() || !r.named_params.is_empty()
+}
+
+fn effect_named(r: &CaseRow) -> bool {
+    !r.named_effects.is_empty()
+}
+
+/// An effect named that is not among the truth's effects.
+fn names_other_effect(r: &CaseRow) -> bool {
+    let t = parse_pairs(&r.truth_effects);
+    split(&r.named_effects)
+        .iter()
+        .any(|n| !t.iter().any(|(e, _)| e == n))
+}
+
+/// Every effect of the truth named (or its parameter alias).
+fn names_every_truth_effect(r: &CaseRow, aliases: &BTreeMap<String, String>) -> bool {
+    parse_pairs(&r.truth_effects)
+        .iter()
+        .all(|(e, _)| names_effect(r, e, aliases))
+}
+
+/// Nulls: false alarms per suite and noise level.
+fn null_scores(rows: &[CaseRow], noise_levels: &[f64], scores: &mut Vec<Score>) {
     for suite in ["main", "one-robot"] {
-        for &noise in &noise_levels {
+        for &noise in noise_levels {
             let nulls: Vec<&CaseRow> = rows
                 .iter()
                 .filter(|r| r.suite == suite && r.kind == "null" && r.noise == noise)
@@ -1115,10 +1205,18 @@ pub fn summarize(
             ));
         }
     }
-    // Single effects, per noise level, multiple ≥ 1.
+}
+
+/// Single effects, per suite, calibration and noise level, multiple ≥ 1.
+fn single_effect_scores(
+    rows: &[CaseRow],
+    noise_levels: &[f64],
+    aliases: &BTreeMap<String, String>,
+    scores: &mut Vec<Score>,
+) {
     for suite in ["main", "one-robot"] {
         for calibrate in [true, false] {
-            for &noise in &noise_levels {
+            for &noise in noise_levels {
                 let cases: Vec<&CaseRow> = rows
                     .iter()
                     .filter(|r| {
@@ -1133,20 +1231,9 @@ pub fn summarize(
                 }
                 let right = cases
                     .iter()
-                    .filter(|r| {
-                        let t = parse_pairs(&r.truth_effects);
-                        t.iter().all(|(e, _)| names_effect(r, e, &aliases))
-                    })
+                    .filter(|r| names_every_truth_effect(r, aliases))
                     .count();
-                let wrong = cases
-                    .iter()
-                    .filter(|r| {
-                        let t = parse_pairs(&r.truth_effects);
-                        split(&r.named_effects)
-                            .iter()
-                            .any(|n| !t.iter().any(|(e, _)| e == n))
-                    })
-                    .count();
+                let wrong = cases.iter().filter(|r| names_other_effect(r)).count();
                 let tag = if calibrate { "" } else { " (calibration off)" };
                 scores.push(score(
                     &format!("{suite}: single effect named{tag} at {:.0} % noise (×1, ×2, ×4 thresholds)", noise * 100.0),
@@ -1166,48 +1253,59 @@ pub fn summarize(
             }
         }
     }
-    // Pairs.
+}
+
+/// Pairs: both named, and a spurious third knob (effect, or a parameter that is not an
+/// alias of a truth effect).
+fn pair_scores(rows: &[CaseRow], aliases: &BTreeMap<String, String>, scores: &mut Vec<Score>) {
     let pairs_rows: Vec<&CaseRow> = rows.iter().filter(|r| r.kind == "pair").collect();
-    if !pairs_rows.is_empty() {
-        let both = pairs_rows
-            .iter()
-            .filter(|r| {
-                parse_pairs(&r.truth_effects)
-                    .iter()
-                    .all(|(e, _)| names_effect(r, e, &aliases))
-            })
-            .count();
-        let third = pairs_rows
-            .iter()
-            .filter(|r| {
-                let t = parse_pairs(&r.truth_effects);
-                let extra_effect = split(&r.named_effects)
-                    .iter()
-                    .any(|n| !t.iter().any(|(e, _)| e == n));
-                let extra_param = split(&r.named_params).iter().any(|n| {
-                    !t.iter().any(|(e, _)| {
-                        aliases
-                            .get(e)
-                            .is_some_and(|p| n.ends_with(&format!(":{p}")))
-                    })
-                });
-                extra_effect || extra_param
-            })
-            .count();
-        scores.push(score(
-            "pairs of effects at 2× thresholds: both named",
-            both,
-            pairs_rows.len(),
-            "≥ 80 %",
-        ));
-        scores.push(score(
-            "pairs: a spurious third knob named",
-            third,
-            pairs_rows.len(),
-            "≤ 5 %",
-        ));
+    if pairs_rows.is_empty() {
+        return;
     }
-    // Parameter errors.
+    let both = pairs_rows
+        .iter()
+        .filter(|r| names_every_truth_effect(r, aliases))
+        .count();
+    let third = pairs_rows
+        .iter()
+        .filter(|r| {
+            let t = parse_pairs(&r.truth_effects);
+            let extra_effect = names_other_effect(r);
+            let extra_param = split(&r.named_params).iter().any(|n| {
+                !t.iter().any(|(e, _)| {
+                    aliases
+                        .get(e)
+                        .is_some_and(|p| n.ends_with(&format!(":{p}")))
+                })
+            });
+            extra_effect || extra_param
+        })
+        .count();
+    scores.push(score(
+        "pairs of effects at 2× thresholds: both named",
+        both,
+        pairs_rows.len(),
+        "≥ 80 %",
+    ));
+    scores.push(score(
+        "pairs: a spurious third knob named",
+        third,
+        pairs_rows.len(),
+        "≤ 5 %",
+    ));
+}
+
+/// The truth's parameter paths.
+fn truth_params(r: &CaseRow) -> Vec<String> {
+    parse_pairs(&r.truth_params)
+        .into_iter()
+        .map(|(k, _)| k)
+        .collect()
+}
+
+/// Parameter errors per suite: an effect wrongly called, a wrong parameter named, the
+/// right declared parameter named, undeclared ones reported unexplained.
+fn parameter_scores(rows: &[CaseRow], scores: &mut Vec<Score>) {
     for suite in ["main", "one-robot"] {
         let p: Vec<&CaseRow> = rows
             .iter()
@@ -1223,10 +1321,7 @@ pub fn summarize(
             "≤ 5 %",
         ));
         let wrong_param = |r: &&&CaseRow| {
-            let truth: Vec<String> = parse_pairs(&r.truth_params)
-                .into_iter()
-                .map(|(k, _)| k)
-                .collect();
+            let truth = truth_params(r);
             split(&r.named_params)
                 .iter()
                 .any(|n| !truth.iter().any(|t| n.ends_with(&format!(":{t}"))))
@@ -1243,11 +1338,7 @@ pub fn summarize(
             declared
                 .iter()
                 .filter(|r| {
-                    let truth: Vec<String> = parse_pairs(&r.truth_params)
-                        .into_iter()
-                        .map(|(k, _)| k)
-                        .collect();
-                    truth.iter().all(|t| {
+                    truth_params(r).iter().all(|t| {
                         split(&r.named_params)
                             .iter()
                             .any(|n| n.ends_with(&format!(":{t}")))
@@ -1265,50 +1356,47 @@ pub fn summarize(
             "high",
         ));
     }
-    // Drake.
+}
+
+/// Drake trials: an effect blamed without one added; with one added, it named and
+/// another named.
+fn drake_scores(rows: &[CaseRow], aliases: &BTreeMap<String, String>, scores: &mut Vec<Score>) {
     let drake: Vec<&CaseRow> = rows.iter().filter(|r| r.kind == "drake").collect();
-    if !drake.is_empty() {
-        let nulls: Vec<&&CaseRow> = drake
-            .iter()
-            .filter(|r| r.truth_effects.is_empty())
-            .collect();
-        scores.push(score(
-            "Drake, no effect added: an effect blamed",
-            nulls.iter().filter(|r| effect_named(r)).count(),
-            nulls.len(),
-            "0 %",
-        ));
-        let with: Vec<&&CaseRow> = drake
-            .iter()
-            .filter(|r| !r.truth_effects.is_empty())
-            .collect();
-        scores.push(score(
-            "Drake, effect added: that effect named (on top of the engine difference)",
-            with.iter()
-                .filter(|r| {
-                    parse_pairs(&r.truth_effects)
-                        .iter()
-                        .all(|(e, _)| names_effect(r, e, &aliases))
-                })
-                .count(),
-            with.len(),
-            "high",
-        ));
-        scores.push(score(
-            "Drake, effect added: another effect named",
-            with.iter()
-                .filter(|r| {
-                    let t = parse_pairs(&r.truth_effects);
-                    split(&r.named_effects)
-                        .iter()
-                        .any(|n| !t.iter().any(|(e, _)| e == n))
-                })
-                .count(),
-            with.len(),
-            "low",
-        ));
+    if drake.is_empty() {
+        return;
     }
-    // Interval coverage over every case whose true knob was named with an interval.
+    let nulls: Vec<&&CaseRow> = drake
+        .iter()
+        .filter(|r| r.truth_effects.is_empty())
+        .collect();
+    scores.push(score(
+        "Drake, no effect added: an effect blamed",
+        nulls.iter().filter(|r| effect_named(r)).count(),
+        nulls.len(),
+        "0 %",
+    ));
+    let with: Vec<&&CaseRow> = drake
+        .iter()
+        .filter(|r| !r.truth_effects.is_empty())
+        .collect();
+    scores.push(score(
+        "Drake, effect added: that effect named (on top of the engine difference)",
+        with.iter()
+            .filter(|r| names_every_truth_effect(r, aliases))
+            .count(),
+        with.len(),
+        "high",
+    ));
+    scores.push(score(
+        "Drake, effect added: another effect named",
+        with.iter().filter(|r| names_other_effect(r)).count(),
+        with.len(),
+        "low",
+    ));
+}
+
+/// Interval coverage over every case whose true knob was named with an interval.
+fn coverage_score(rows: &[CaseRow], aliases: &BTreeMap<String, String>) -> Score {
     let mut cov = (0usize, 0usize);
     for r in rows {
         for (e, v) in parse_pairs(&r.truth_effects) {
@@ -1337,16 +1425,19 @@ pub fn summarize(
             }
         }
     }
-    scores.push(score(
+    score(
         "95 % intervals holding the truth (every case that named its true knob)",
         cov.0,
         cov.1,
         "90–97 %",
-    ));
-    // Confusions: single effects (main, calibration on) by noise; parameter errors.
+    )
+}
+
+/// Confusions: single effects (main) by calibration and noise; parameter errors.
+fn confusions(rows: &[CaseRow], noise_levels: &[f64]) -> Vec<Confusion> {
     let mut confusions = Vec::new();
     for calibrate in [true, false] {
-        for &noise in &noise_levels {
+        for &noise in noise_levels {
             let cases: Vec<&CaseRow> = rows
                 .iter()
                 .filter(|r| {
@@ -1388,37 +1479,29 @@ pub fn summarize(
             ));
         }
     }
-    {
-        let cases: Vec<&CaseRow> = rows
-            .iter()
-            .filter(|r| r.suite == "main" && r.kind == "parameter")
-            .collect();
-        if !cases.is_empty() {
-            let label = |r: &CaseRow| -> String {
-                let mut v: Vec<String> = split(&r.named_params)
-                    .iter()
-                    .map(|p| p.split(':').nth(1).unwrap_or(p).to_string())
-                    .collect();
-                v.extend(split(&r.named_effects));
-                if v.is_empty() {
-                    "none".into()
-                } else {
-                    v.join(" + ")
-                }
-            };
-            confusions.push(confusion(
-                "nominal-parameter errors (main suite): what was named".into(),
-                &cases,
-                |r| r.truth_params.clone(),
-                label,
-            ));
-        }
+    let cases: Vec<&CaseRow> = rows
+        .iter()
+        .filter(|r| r.suite == "main" && r.kind == "parameter")
+        .collect();
+    if !cases.is_empty() {
+        let label = |r: &CaseRow| -> String {
+            let mut v: Vec<String> = split(&r.named_params)
+                .iter()
+                .map(|p| p.split(':').nth(1).unwrap_or(p).to_string())
+                .collect();
+            v.extend(split(&r.named_effects));
+            if v.is_empty() {
+                "none".into()
+            } else {
+                v.join(" + ")
+            }
+        };
+        confusions.push(confusion(
+            "nominal-parameter errors (main suite): what was named".into(),
+            &cases,
+            |r| r.truth_params.clone(),
+            label,
+        ));
     }
-    BenchmarkSummary {
-        design: opts.design.clone(),
-        cases: rows.len(),
-        scores,
-        confusions,
-        thresholds,
-    }
+    confusions
 }

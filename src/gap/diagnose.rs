@@ -466,19 +466,7 @@ pub fn diagnose_conditions(
         origin: set.origin.clone(),
         source: e,
     })?;
-    if opts.calibrate && !knobs.list.iter().any(|k| k.kind == KnobKind::Parameter) {
-        notes.push(
-            "no design of these trials declares [[uncertain]] parameters: the nominal model is \
-             taken as right (only effects are candidates)"
-                .into(),
-        );
-    }
-    for (e, p) in &knobs.aliased {
-        notes.push(format!(
-            "{e} is not tested as an effect: the design declares {p} uncertain, and calibrating \
-             it is the same physics"
-        ));
-    }
+    knob_notes(&knobs, opts.calibrate, &mut notes);
     let walks0 = cache.walks();
     let mut timing = Timing::default();
     let n = obs.len();
@@ -557,17 +545,7 @@ pub fn diagnose_conditions(
     let where_ = metric_gaps(&residuals, opts.alpha);
     let summary = summarize(&where_, nominal_within_noise);
     let identifiability = if opts.identifiability {
-        let k = knobs
-            .list
-            .iter()
-            .filter(|k| k.kind == KnobKind::Effect)
-            .count()
-            .max(1) as f64;
-        progress("identifiability thresholds");
-        identifiability(&ctx, opts.alpha / k, &|name: &str| match lib.get(name) {
-            Ok(def) => (def.magnitude().name.clone(), def.magnitude().unit.clone()),
-            Err(_) => (String::new(), String::new()),
-        })?
+        effect_thresholds(&ctx, opts.alpha)?
     } else {
         Vec::new()
     };
@@ -607,6 +585,41 @@ pub fn diagnose_conditions(
         },
         timing,
     ))
+}
+
+/// Notes on the knobs: no uncertain parameter to calibrate, effects aliased to a declared
+/// parameter.
+fn knob_notes(knobs: &Knobs, calibrate: bool, notes: &mut Vec<String>) {
+    if calibrate && !knobs.list.iter().any(|k| k.kind == KnobKind::Parameter) {
+        notes.push(
+            "no design of these trials declares [[uncertain]] parameters: the nominal model is \
+             taken as right (only effects are candidates)"
+                .into(),
+        );
+    }
+    for (e, p) in &knobs.aliased {
+        notes.push(format!(
+            "{e} is not tested as an effect: the design declares {p} uncertain, and calibrating \
+             it is the same physics"
+        ));
+    }
+}
+
+/// Every effect's identification threshold, at `alpha` shared over the effects
+/// (Bonferroni).
+fn effect_thresholds(ctx: &FitContext<'_>, alpha: f64) -> Result<Vec<Identifiability>, GapError> {
+    let k = ctx
+        .knobs
+        .list
+        .iter()
+        .filter(|k| k.kind == KnobKind::Effect)
+        .count()
+        .max(1) as f64;
+    (ctx.progress)("identifiability thresholds");
+    identifiability(ctx, alpha / k, &|name: &str| match ctx.lib.get(name) {
+        Ok(def) => (def.magnitude().name.clone(), def.magnitude().unit.clone()),
+        Err(_) => (String::new(), String::new()),
+    })
 }
 
 /// Every knob alone, fitted from the nominal on the surrogate, held-out gap and LR test.

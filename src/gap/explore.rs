@@ -21,7 +21,7 @@ use super::error::GapError;
 use super::knob::{KnobKind, Knobs};
 use super::library::EffectLibrary;
 use super::problem::{Observation, chi2_of};
-use super::simulate::Condition;
+use super::simulate::{Condition, SimMetrics};
 use super::trials::{Metric, TrialSet};
 use crate::regression::dist::chi2_upper_p;
 
@@ -244,69 +244,16 @@ pub fn explore(
         ));
     }
 
-    let parameters = params
-        .iter()
-        .enumerate()
-        .map(|(j, i)| {
-            let k = &knobs.list[*i];
-            let coord = |p: &Vec<Option<f64>>| p[*i].unwrap_or(f64::NAN);
-            let plaus: Vec<f64> = points
-                .iter()
-                .zip(&plausible)
-                .filter(|(_, ok)| **ok)
-                .map(|(p, _)| coord(p))
-                .collect();
-            let (plausible_range, width) = if plaus.is_empty() {
-                (None, None)
-            } else {
-                let lo = plaus.iter().copied().fold(f64::INFINITY, f64::min);
-                let hi = plaus.iter().copied().fold(f64::NEG_INFINITY, f64::max);
-                (
-                    Some([k.value(lo), k.value(hi)]),
-                    Some((hi - lo) / (k.hi - k.lo)),
-                )
-            };
-            let xs: Vec<f64> = walking.iter().map(|w| units[*w][j]).collect();
-            let ys: Vec<f64> = walking.iter().map(|w| chi2[*w]).collect();
-            ParameterReach {
-                parameter: k.label(),
-                nominal: k.nominal.map(|x| k.value(x)).unwrap_or(f64::NAN),
-                range: [k.value(k.lo), k.value(k.hi)],
-                best: k.value(coord(&points[best])),
-                plausible: plausible_range,
-                plausible_width: width,
-                rank_correlation_with_chi2: if xs.len() > 2 {
-                    spearman(&xs, &ys)
-                } else {
-                    f64::NAN
-                },
-                why: k.why.clone(),
-            }
-        })
-        .collect();
-
-    let metrics = obs
-        .iter()
-        .map(|o: &Observation| {
-            let vals: Vec<f64> = walking
-                .iter()
-                .map(|w| sample_sims[*w][o.trial].get(o.metric))
-                .filter(|v| v.is_finite())
-                .collect();
-            let lo = vals.iter().copied().fold(f64::INFINITY, f64::min);
-            let hi = vals.iter().copied().fold(f64::NEG_INFINITY, f64::max);
-            MetricReach {
-                trial: set.trials[o.trial].label.clone(),
-                metric: o.metric,
-                measured: o.value,
-                sd: o.sd,
-                nominal: sims[0][o.trial].get(o.metric),
-                reach: [lo, hi],
-                best: sample_sims[best][o.trial].get(o.metric),
-                reachable: lo - 2.0 * o.sd <= o.value && o.value <= hi + 2.0 * o.sd,
-            }
-        })
-        .collect();
+    let samples = Samples {
+        units: &units,
+        points: &points,
+        chi2: &chi2,
+        plausible: &plausible,
+        walking: &walking,
+        best,
+    };
+    let parameters = samples.parameters(&knobs, &params);
+    let metrics = samples.metrics(&obs, set, sample_sims, &sims[0]);
 
     Ok(Exploration {
         origin: set.origin.clone(),
@@ -326,6 +273,100 @@ pub fn explore(
         walks: cache.walks() - walks_before,
         notes,
     })
+}
+
+/// The samples of an exploration, each a setting of the explored parameters.
+struct Samples<'a> {
+    /// Unit-cube coordinates [sample][parameter].
+    units: &'a [Vec<f64>],
+    /// Knob points [sample][knob].
+    points: &'a [Vec<Option<f64>>],
+    chi2: &'a [f64],
+    plausible: &'a [bool],
+    /// The samples that walked on every condition.
+    walking: &'a [usize],
+    best: usize,
+}
+
+impl Samples<'_> {
+    /// Each parameter's reach: its plausible range, best value and the rank correlation of
+    /// its coordinate with χ² over the walking samples.
+    fn parameters(&self, knobs: &Knobs, params: &[usize]) -> Vec<ParameterReach> {
+        params
+            .iter()
+            .enumerate()
+            .map(|(j, i)| {
+                let k = &knobs.list[*i];
+                let coord = |p: &Vec<Option<f64>>| p[*i].unwrap_or(f64::NAN);
+                let plaus: Vec<f64> = self
+                    .points
+                    .iter()
+                    .zip(self.plausible)
+                    .filter(|(_, ok)| **ok)
+                    .map(|(p, _)| coord(p))
+                    .collect();
+                let (plausible_range, width) = if plaus.is_empty() {
+                    (None, None)
+                } else {
+                    let lo = plaus.iter().copied().fold(f64::INFINITY, f64::min);
+                    let hi = plaus.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+                    (
+                        Some([k.value(lo), k.value(hi)]),
+                        Some((hi - lo) / (k.hi - k.lo)),
+                    )
+                };
+                let xs: Vec<f64> = self.walking.iter().map(|w| self.units[*w][j]).collect();
+                let ys: Vec<f64> = self.walking.iter().map(|w| self.chi2[*w]).collect();
+                ParameterReach {
+                    parameter: k.label(),
+                    nominal: k.nominal.map(|x| k.value(x)).unwrap_or(f64::NAN),
+                    range: [k.value(k.lo), k.value(k.hi)],
+                    best: k.value(coord(&self.points[self.best])),
+                    plausible: plausible_range,
+                    plausible_width: width,
+                    rank_correlation_with_chi2: if xs.len() > 2 {
+                        spearman(&xs, &ys)
+                    } else {
+                        f64::NAN
+                    },
+                    why: k.why.clone(),
+                }
+            })
+            .collect()
+    }
+
+    /// Each observation's reach over the walking samples, and whether the measured value
+    /// lies within it (±2 sd).
+    fn metrics(
+        &self,
+        obs: &[Observation],
+        set: &TrialSet,
+        sample_sims: &[Vec<SimMetrics>],
+        nominal: &[SimMetrics],
+    ) -> Vec<MetricReach> {
+        obs.iter()
+            .map(|o: &Observation| {
+                let vals: Vec<f64> = self
+                    .walking
+                    .iter()
+                    .map(|w| sample_sims[*w][o.trial].get(o.metric))
+                    .filter(|v| v.is_finite())
+                    .collect();
+                let lo = vals.iter().copied().fold(f64::INFINITY, f64::min);
+                let hi = vals.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+                MetricReach {
+                    trial: set.trials[o.trial].label.clone(),
+                    metric: o.metric,
+                    measured: o.value,
+                    sd: o.sd,
+                    nominal: nominal[o.trial].get(o.metric),
+                    reach: [lo, hi],
+                    best: sample_sims[self.best][o.trial].get(o.metric),
+                    reachable: lo - 2.0 * o.sd <= o.value && o.value <= hi + 2.0 * o.sd,
+                }
+            })
+            .collect()
+    }
 }
 
 #[cfg(test)]

@@ -912,6 +912,26 @@ mod tests {
         assert_eq!((lo, open_lo, hi, open_hi), (0.0, true, 1.0, true));
     }
 
+    /// A profile interval cut by the range end: χ²(t) = a·(t − t₀)² + c with a = 4000,
+    /// t₀ = 0.01 crosses c + 3.8415 at t₀ ± √(3.8415/4000) = 0.01 ± 0.030990, so the
+    /// lower end is below the range (open at 0) and the upper end is 0.040990. A steeper
+    /// a = 10⁶ around t₀ = 0.5 gives 0.5 ± 0.0019600, within the bisection's 1/2048.
+    #[test]
+    fn profile_bracket_is_open_at_a_range_end() {
+        let dchi = 3.841_458_820_694_124;
+        let (a, t0, c) = (4000.0, 0.01, 7.0);
+        let f = |t: f64| -> Result<f64, GapError> { Ok(a * (t - t0) * (t - t0) + c) };
+        let (lo, open_lo, hi, open_hi) = bracket_profile(t0, c, c + dchi, f).expect("bracket");
+        assert_eq!((lo, open_lo), (0.0, true));
+        assert!((hi - 0.040_990).abs() < 1.0 / 2048.0, "{hi}");
+        assert!(!open_hi);
+        let (a, t0) = (1e6, 0.5);
+        let f = |t: f64| -> Result<f64, GapError> { Ok(a * (t - t0) * (t - t0) + c) };
+        let (lo, _, hi, _) = bracket_profile(t0, c, c + dchi, f).expect("bracket");
+        assert!((lo - (0.5 - 0.001_960_0)).abs() < 1.0 / 2048.0, "{lo}");
+        assert!((hi - (0.5 + 0.001_960_0)).abs() < 1.0 / 2048.0, "{hi}");
+    }
+
     /// χ²₁ upper tail at 3.841459 is 0.05; with over-dispersion φ the test is F(1, dof) on
     /// LR/φ: F(1, 50) at 4.034 has upper tail 0.05 (R: qf(0.95, 1, 50) = 4.034310).
     #[test]

@@ -298,6 +298,66 @@ pub fn separate_with(
         origin: "designs".into(),
         source: e,
     })?;
+    let idx = candidate_knobs(&knobs, opts)?;
+    let with_logs = sigs.iter().filter(|s| s.is_some()).count();
+    if with_logs == 0 {
+        notes.push(
+            "no trial names a log (`trajectory` column): only the summaries can separate the \
+             candidates"
+                .into(),
+        );
+    }
+    let walker = Walker {
+        conditions,
+        lib,
+        settle_cycles: opts.settle_cycles,
+        cache,
+        progress,
+        walks: std::sync::atomic::AtomicUsize::new(0),
+    };
+    let nominal = walker.run((String::new(), 0), &super::knob::ModelSetting::nominal())?;
+    let (nom_s, nom_w) = chi2_pair(&obs, sigs, &nominal, opts.relative_floor);
+    let n_wave: usize = sigs.iter().flatten().map(coefficient_count).sum();
+
+    let mut fits: Vec<[Best; 2]> = Vec::new();
+    for &k in &idx {
+        fits.push(fit_candidate(&walker, &knobs, k, &obs, sigs, opts)?);
+    }
+    let fitted = Fitted {
+        obs: &obs,
+        sigs,
+        knobs: &knobs,
+        idx: &idx,
+        fits: &fits,
+        nominal: (nom_s, nom_w),
+        n_wave,
+        opts,
+    };
+    let mut rankings = Vec::new();
+    for (mi, mode) in [Evidence::Summaries, Evidence::SummariesAndWaveforms]
+        .into_iter()
+        .enumerate()
+    {
+        if mode == Evidence::SummariesAndWaveforms && with_logs == 0 {
+            continue;
+        }
+        rankings.push(fitted.ranking(mi, mode));
+    }
+    let cycles = fitted.cycles(set, &rankings, &nominal);
+    Ok(Separation {
+        trials: set.trials.len(),
+        trials_with_logs: with_logs,
+        relative_floor: opts.relative_floor,
+        alpha: opts.alpha,
+        rankings,
+        cycles,
+        notes,
+        walks: walker.walks.into_inner(),
+    })
+}
+
+/// The knob indices of the candidates, in the order given, each once.
+fn candidate_knobs(knobs: &Knobs, opts: &SeparateOptions) -> Result<Vec<usize>, GapError> {
     let mut idx = Vec::new();
     for c in &opts.candidates {
         let i = knobs.index_of(c).ok_or_else(|| {
@@ -316,109 +376,146 @@ pub fn separate_with(
             idx.push(i);
         }
     }
-    let with_logs = sigs.iter().filter(|s| s.is_some()).count();
-    if with_logs == 0 {
-        notes.push(
-            "no trial names a log (`trajectory` column): only the summaries can separate the \
-             candidates"
-                .into(),
-        );
-    }
-    let walks = std::sync::atomic::AtomicUsize::new(0);
-    let run = |key: CacheKey,
-               setting: &super::knob::ModelSetting|
-     -> Result<Arc<Vec<SimCycle>>, GapError> {
-        if let Some(v) = cache.get(&key)? {
+    Ok(idx)
+}
+
+/// Walks every condition under a setting, through the cache, counting the walks.
+struct Walker<'a> {
+    conditions: &'a [Condition],
+    lib: &'a EffectLibrary,
+    settle_cycles: usize,
+    cache: &'a CycleCache,
+    progress: &'a (dyn Fn() + Sync),
+    walks: std::sync::atomic::AtomicUsize,
+}
+
+impl Walker<'_> {
+    fn run(
+        &self,
+        key: CacheKey,
+        setting: &super::knob::ModelSetting,
+    ) -> Result<Arc<Vec<SimCycle>>, GapError> {
+        if let Some(v) = self.cache.get(&key)? {
             return Ok(v);
         }
-        let r: Vec<SimCycle> = conditions
+        let r: Vec<SimCycle> = self
+            .conditions
             .par_iter()
-            .map(|c| simulate_cycles(c, lib, setting, opts.settle_cycles))
+            .map(|c| simulate_cycles(c, self.lib, setting, self.settle_cycles))
             .collect::<Result<Vec<_>, _>>()?;
-        walks.fetch_add(conditions.len(), std::sync::atomic::Ordering::Relaxed);
-        progress();
+        self.walks
+            .fetch_add(self.conditions.len(), std::sync::atomic::Ordering::Relaxed);
+        (self.progress)();
         let r = Arc::new(r);
-        cache.put(key, r.clone())?;
+        self.cache.put(key, r.clone())?;
         Ok(r)
+    }
+}
+
+/// A candidate's best fit in one evidence mode.
+struct Best {
+    x: f64,
+    sims: Arc<Vec<SimCycle>>,
+    s: f64,
+    w: f64,
+}
+
+/// Each candidate: grid, then golden section per evidence kind, all on walks. Returns the
+/// best fit on summaries and on summaries and waveforms.
+fn fit_candidate(
+    walker: &Walker,
+    knobs: &Knobs,
+    k: usize,
+    obs: &[Observation],
+    sigs: &[Option<CycleSignature>],
+    opts: &SeparateOptions,
+) -> Result<[Best; 2], GapError> {
+    let knob = &knobs.list[k];
+    let label = knob.label();
+    let eval = |x: f64| -> Result<(Arc<Vec<SimCycle>>, f64, f64), GapError> {
+        let mut point = knobs.nominal_point();
+        point[k] = Some(x);
+        let sims = walker.run(
+            (label.clone(), x.to_bits()),
+            &knobs.setting(walker.lib, &point),
+        )?;
+        let (s, w) = chi2_pair(obs, sigs, &sims, opts.relative_floor);
+        Ok((sims, s, w))
     };
-    let nominal = run((String::new(), 0), &super::knob::ModelSetting::nominal())?;
-    let (nom_s, nom_w) = chi2_pair(&obs, sigs, &nominal, opts.relative_floor);
-    let n_wave: usize = sigs.iter().flatten().map(coefficient_count).sum();
-
-    // Each candidate: grid, then golden section per evidence kind, all on walks.
-    struct Best {
-        x: f64,
-        sims: Arc<Vec<SimCycle>>,
-        s: f64,
-        w: f64,
+    let nodes = knob.nodes(opts.grid_points);
+    let mut grid = Vec::with_capacity(nodes.len());
+    for &x in &nodes {
+        grid.push(eval(x)?);
     }
-    let mut fits: Vec<[Best; 2]> = Vec::new();
-    for &k in &idx {
-        let knob = &knobs.list[k];
-        let label = knob.label();
-        let eval = |x: f64| -> Result<(Arc<Vec<SimCycle>>, f64, f64), GapError> {
-            let mut point = knobs.nominal_point();
-            point[k] = Some(x);
-            let sims = run((label.clone(), x.to_bits()), &knobs.setting(lib, &point))?;
-            let (s, w) = chi2_pair(&obs, sigs, &sims, opts.relative_floor);
-            Ok((sims, s, w))
+    let pick = |mode: Evidence| -> Result<Best, GapError> {
+        let cost = |s: f64, w: f64| match mode {
+            Evidence::Summaries => s,
+            Evidence::SummariesAndWaveforms => s + w,
         };
-        let nodes = knob.nodes(opts.grid_points);
-        let mut grid = Vec::with_capacity(nodes.len());
-        for &x in &nodes {
-            grid.push(eval(x)?);
+        let j = (0..nodes.len())
+            .min_by(|a, b| cost(grid[*a].1, grid[*a].2).total_cmp(&cost(grid[*b].1, grid[*b].2)))
+            .unwrap_or(0);
+        let mut best = Best {
+            x: nodes[j],
+            sims: grid[j].0.clone(),
+            s: grid[j].1,
+            w: grid[j].2,
+        };
+        // Golden section between the best node's neighbours on walks: refine_steps + 1
+        // walk sets (two open the bracket), kept only where it beats the node.
+        let (a, b) = (
+            nodes[j.saturating_sub(1)],
+            nodes[(j + 1).min(nodes.len() - 1)],
+        );
+        let (x, c, (sims, s, w)) =
+            super::solver::golden_section(a, b, opts.refine_steps.saturating_sub(1), |x| {
+                eval(x).map(|(sims, s, w)| (cost(s, w), (sims, s, w)))
+            })?;
+        if c < cost(best.s, best.w) {
+            best = Best { x, sims, s, w };
         }
-        let pick = |mode: Evidence| -> Result<Best, GapError> {
-            let cost = |s: f64, w: f64| match mode {
-                Evidence::Summaries => s,
-                Evidence::SummariesAndWaveforms => s + w,
-            };
-            let j = (0..nodes.len())
-                .min_by(|a, b| {
-                    cost(grid[*a].1, grid[*a].2).total_cmp(&cost(grid[*b].1, grid[*b].2))
-                })
-                .unwrap_or(0);
-            let mut best = Best {
-                x: nodes[j],
-                sims: grid[j].0.clone(),
-                s: grid[j].1,
-                w: grid[j].2,
-            };
-            // Golden section between the best node's neighbours on walks: refine_steps + 1
-            // walk sets (two open the bracket), kept only where it beats the node.
-            let (a, b) = (
-                nodes[j.saturating_sub(1)],
-                nodes[(j + 1).min(nodes.len() - 1)],
-            );
-            let (x, c, (sims, s, w)) =
-                super::solver::golden_section(a, b, opts.refine_steps.saturating_sub(1), |x| {
-                    eval(x).map(|(sims, s, w)| (cost(s, w), (sims, s, w)))
-                })?;
-            if c < cost(best.s, best.w) {
-                best = Best { x, sims, s, w };
-            }
-            Ok(best)
-        };
-        let by_summary = pick(Evidence::Summaries)?;
-        let by_both = pick(Evidence::SummariesAndWaveforms)?;
-        fits.push([by_summary, by_both]);
-    }
+        Ok(best)
+    };
+    let by_summary = pick(Evidence::Summaries)?;
+    let by_both = pick(Evidence::SummariesAndWaveforms)?;
+    Ok([by_summary, by_both])
+}
 
-    let mut rankings = Vec::new();
-    for (mi, mode) in [Evidence::Summaries, Evidence::SummariesAndWaveforms]
-        .into_iter()
-        .enumerate()
-    {
-        if mode == Evidence::SummariesAndWaveforms && with_logs == 0 {
-            continue;
-        }
-        let n = obs.len() + if mi == 1 { n_wave } else { 0 };
-        let cost = |s: f64, w: f64| if mi == 1 { s + w } else { s };
-        let mut list: Vec<CandidateFit> = idx
+/// The candidates' fits, ready to be ranked.
+struct Fitted<'a> {
+    obs: &'a [Observation],
+    sigs: &'a [Option<CycleSignature>],
+    knobs: &'a Knobs,
+    idx: &'a [usize],
+    /// Per candidate (as `idx`): the best fit by summaries, and by summaries and waveforms.
+    fits: &'a [[Best; 2]],
+    /// The nominal's χ² on summaries and on waveforms.
+    nominal: (f64, f64),
+    n_wave: usize,
+    opts: &'a SeparateOptions,
+}
+
+impl Fitted<'_> {
+    /// The position in `idx` (and `fits`) of the knob with this label (0 if none).
+    fn position(&self, label: &str) -> usize {
+        self.idx
             .iter()
-            .zip(&fits)
+            .position(|&k| self.knobs.list[k].label() == label)
+            .unwrap_or(0)
+    }
+
+    /// The ranking in one evidence mode (`mi` 0: summaries; 1: summaries and waveforms).
+    fn ranking(&self, mi: usize, mode: Evidence) -> Ranking {
+        let (obs, opts) = (self.obs, self.opts);
+        let (nom_s, nom_w) = self.nominal;
+        let n = obs.len() + if mi == 1 { self.n_wave } else { 0 };
+        let cost = |s: f64, w: f64| if mi == 1 { s + w } else { s };
+        let mut list: Vec<CandidateFit> = self
+            .idx
+            .iter()
+            .zip(self.fits)
             .map(|(&k, f)| {
-                let knob = &knobs.list[k];
+                let knob = &self.knobs.list[k];
                 let b = &f[mi];
                 let span = knob.hi - knob.lo;
                 CandidateFit {
@@ -445,7 +542,7 @@ pub fn separate_with(
         let blocks: Vec<(usize, f64, f64)> = if mi == 1 {
             vec![
                 (obs.len(), list[0].chi2_summaries, nom_s),
-                (n_wave, list[0].chi2_waveforms, nom_w),
+                (self.n_wave, list[0].chi2_waveforms, nom_w),
             ]
         } else {
             vec![(obs.len(), list[0].chi2_summaries, nom_s)]
@@ -482,12 +579,9 @@ pub fn separate_with(
         let verdict = if !lr_gap && nominal_fits {
             Verdict::NoGap
         } else if best_p < opts.alpha {
-            let b = &fits[idx
-                .iter()
-                .position(|&k| knobs.list[k].label() == list[0].knob)
-                .unwrap_or(0)][mi];
+            let b = &self.fits[self.position(&list[0].knob)][mi];
             Verdict::NoneFits {
-                rest_in: rest_in(&obs, sigs, &b.sims, opts.relative_floor, mi == 1),
+                rest_in: rest_in(obs, self.sigs, &b.sims, opts.relative_floor, mi == 1),
             }
         } else if !lr_gap {
             Verdict::NoGap
@@ -504,7 +598,7 @@ pub fn separate_with(
                     .collect(),
             }
         };
-        rankings.push(Ranking {
+        Ranking {
             evidence: mode,
             fits: list,
             nominal_chi2,
@@ -512,40 +606,36 @@ pub fn separate_with(
             overdispersion: phi,
             best_p_value: best_p,
             verdict,
-        });
-    }
-
-    // Cycles for the figure: every trial with a log, nominal and the waveform ranking's best.
-    let mut cycles = Vec::new();
-    if let Some(r) = rankings
-        .iter()
-        .find(|r| r.evidence == Evidence::SummariesAndWaveforms)
-    {
-        let bi = idx
-            .iter()
-            .position(|&k| knobs.list[k].label() == r.fits[0].knob)
-            .unwrap_or(0);
-        for (i, m) in sigs.iter().enumerate() {
-            let Some(m) = m else { continue };
-            cycles.push(TrialCycles {
-                trial: set.trials[i].name(),
-                measured: m.clone(),
-                nominal: nominal[i].cycles.clone(),
-                best: fits[bi][1].sims[i].cycles.clone(),
-                best_knob: r.fits[0].knob.clone(),
-            });
         }
     }
-    Ok(Separation {
-        trials: set.trials.len(),
-        trials_with_logs: with_logs,
-        relative_floor: opts.relative_floor,
-        alpha: opts.alpha,
-        rankings,
-        cycles,
-        notes,
-        walks: walks.into_inner(),
-    })
+
+    /// Cycles for the figure: every trial with a log, nominal and the waveform ranking's
+    /// best.
+    fn cycles(
+        &self,
+        set: &TrialSet,
+        rankings: &[Ranking],
+        nominal: &[SimCycle],
+    ) -> Vec<TrialCycles> {
+        let mut cycles = Vec::new();
+        if let Some(r) = rankings
+            .iter()
+            .find(|r| r.evidence == Evidence::SummariesAndWaveforms)
+        {
+            let bi = self.position(&r.fits[0].knob);
+            for (i, m) in self.sigs.iter().enumerate() {
+                let Some(m) = m else { continue };
+                cycles.push(TrialCycles {
+                    trial: set.trials[i].name(),
+                    measured: m.clone(),
+                    nominal: nominal[i].cycles.clone(),
+                    best: self.fits[bi][1].sims[i].cycles.clone(),
+                    best_knob: r.fits[0].knob.clone(),
+                });
+            }
+        }
+        cycles
+    }
 }
 
 fn poisoned<T>(_: T) -> GapError {

@@ -170,38 +170,15 @@ pub fn suggest(
             Ok(r)
         })
         .collect::<Result<_, GapError>>()?;
-    // Smoothness: each leader a step below and above its fitted value; a condition where
-    // the metrics bend more than SMOOTHNESS_Z sds over that step (or a step falls) is a
-    // knife-edge gait: a trial there cannot be fitted reliably, whatever it separates.
     let smooth: Vec<bool> = pool
         .par_iter()
         .zip(&walks)
         .map(|(c, w)| {
-            if w.iter().any(|x| x.metrics.fell) {
-                return Ok(false);
+            let ok = is_smooth(c, w, lib, &settings, settle, relative_sd)?;
+            if ok {
+                progress();
             }
-            for (lead, (lo, hi)) in [(1usize, (2usize, 3usize)), (2, (4, 5))] {
-                let minus = simulate_cycles(c, lib, &settings[lo], settle)?;
-                let plus = simulate_cycles(c, lib, &settings[hi], settle)?;
-                if minus.metrics.fell || plus.metrics.fell {
-                    return Ok(false);
-                }
-                for m in Metric::SIMULATED {
-                    let (a, b, x) = (
-                        minus.metrics.get(m),
-                        plus.metrics.get(m),
-                        w[lead].metrics.get(m),
-                    );
-                    if a.is_finite() && b.is_finite() && x.is_finite() && x != 0.0 {
-                        let bend = (a + b - 2.0 * x).abs() / (relative_sd * x.abs());
-                        if bend > SMOOTHNESS_Z {
-                            return Ok(false);
-                        }
-                    }
-                }
-            }
-            progress();
-            Ok(true)
+            Ok(ok)
         })
         .collect::<Result<_, GapError>>()?;
     let knife_edge = walks
@@ -209,41 +186,8 @@ pub fn suggest(
         .zip(&smooth)
         .filter(|(w, ok)| !**ok && !w.iter().any(|x| x.metrics.fell))
         .count();
-    let score = |c: &Condition, w: &[SimCycle; 3]| -> Option<Suggested> {
-        if w.iter().any(|x| x.metrics.fell) {
-            return None;
-        }
-        let (a, b) = (&w[1], &w[2]);
-        let mut s = 0.0;
-        for m in Metric::SIMULATED {
-            let (x, y) = (a.metrics.get(m), b.metrics.get(m));
-            if x.is_finite() && y.is_finite() && x != 0.0 {
-                s += ((x - y) / (relative_sd * x.abs())).powi(2).min(MAX_Z2);
-            }
-        }
-        let wv = match (&a.cycles, &b.cycles) {
-            (Some(x), Some(y)) => waveform::chi2(x, y, opts.separate.relative_floor)
-                .per_signal
-                .iter()
-                .map(|(_, c2, _)| c2.min(MAX_Z2))
-                .sum(),
-            _ => 0.0,
-        };
-        let scaled = c
-            .design
-            .scaled(c.leg_length_m, c.mass_law, c.contact)
-            .ok()?;
-        Some(Suggested {
-            label: String::new(),
-            leg_length_m: c.leg_length_m,
-            frequency_hz: c.frequency_hz.unwrap_or(f64::NAN),
-            amplitude_deg: c.amplitude_deg,
-            mass_kg: c.mass_kg.unwrap_or(scaled.mass.total_mass_kg),
-            slope_deg: c.slope_deg.unwrap_or(0.0),
-            separation_summaries: s,
-            separation_waveforms: wv,
-        })
-    };
+    let floor = opts.separate.relative_floor;
+    let score = |c: &Condition, w: &[SimCycle; 3]| score_condition(c, w, relative_sd, floor);
     let mut scored: Vec<Suggested> = pool
         .iter()
         .zip(&walks)
@@ -286,7 +230,88 @@ pub fn suggest(
     })
 }
 
-/// The settings of the two leading candidates at their fitted values.
+/// Smoothness: each leader a step below and above its fitted value; a condition where
+/// the metrics bend more than SMOOTHNESS_Z sds over that step (or a step falls) is a
+/// knife-edge gait: a trial there cannot be fitted reliably, whatever it separates.
+/// `w` are the condition's walks under the nominal and the two leaders, `settings` those
+/// of [`separate_settings`].
+fn is_smooth(
+    c: &Condition,
+    w: &[SimCycle; 3],
+    lib: &EffectLibrary,
+    settings: &[super::knob::ModelSetting],
+    settle: usize,
+    relative_sd: f64,
+) -> Result<bool, GapError> {
+    if w.iter().any(|x| x.metrics.fell) {
+        return Ok(false);
+    }
+    for (lead, (lo, hi)) in [(1usize, (2usize, 3usize)), (2, (4, 5))] {
+        let minus = simulate_cycles(c, lib, &settings[lo], settle)?;
+        let plus = simulate_cycles(c, lib, &settings[hi], settle)?;
+        if minus.metrics.fell || plus.metrics.fell {
+            return Ok(false);
+        }
+        for m in Metric::SIMULATED {
+            let (a, b, x) = (
+                minus.metrics.get(m),
+                plus.metrics.get(m),
+                w[lead].metrics.get(m),
+            );
+            if a.is_finite() && b.is_finite() && x.is_finite() && x != 0.0 {
+                let bend = (a + b - 2.0 * x).abs() / (relative_sd * x.abs());
+                if bend > SMOOTHNESS_Z {
+                    return Ok(false);
+                }
+            }
+        }
+    }
+    Ok(true)
+}
+
+/// How far apart the two leaders' walks at a condition are (summaries and waveforms,
+/// each term capped at MAX_Z2); `None` when a walk fell or the design cannot be scaled.
+fn score_condition(
+    c: &Condition,
+    w: &[SimCycle; 3],
+    relative_sd: f64,
+    floor: f64,
+) -> Option<Suggested> {
+    if w.iter().any(|x| x.metrics.fell) {
+        return None;
+    }
+    let (a, b) = (&w[1], &w[2]);
+    let mut s = 0.0;
+    for m in Metric::SIMULATED {
+        let (x, y) = (a.metrics.get(m), b.metrics.get(m));
+        if x.is_finite() && y.is_finite() && x != 0.0 {
+            s += ((x - y) / (relative_sd * x.abs())).powi(2).min(MAX_Z2);
+        }
+    }
+    let wv = match (&a.cycles, &b.cycles) {
+        (Some(x), Some(y)) => waveform::chi2(x, y, floor)
+            .per_signal
+            .iter()
+            .map(|(_, c2, _)| c2.min(MAX_Z2))
+            .sum(),
+        _ => 0.0,
+    };
+    let scaled = c
+        .design
+        .scaled(c.leg_length_m, c.mass_law, c.contact)
+        .ok()?;
+    Some(Suggested {
+        label: String::new(),
+        leg_length_m: c.leg_length_m,
+        frequency_hz: c.frequency_hz.unwrap_or(f64::NAN),
+        amplitude_deg: c.amplitude_deg,
+        mass_kg: c.mass_kg.unwrap_or(scaled.mass.total_mass_kg),
+        slope_deg: c.slope_deg.unwrap_or(0.0),
+        separation_summaries: s,
+        separation_waveforms: wv,
+    })
+}
+
 /// The settings of the two leading candidates at their fitted values, and each a step
 /// [`SMOOTHNESS_STEP`] (of its range, in its coordinate) below and above: [A, B, A−, A+, B−, B+].
 fn separate_settings(

@@ -209,176 +209,29 @@ impl TrialSet {
 
     /// Parses and validates a trials CSV; `origin` names it in errors.
     pub fn parse(text: &str, origin: &str, base_dir: &Path) -> Result<TrialSet, GapError> {
-        let err = |line: u64, column: usize, message: String| GapError::Trials {
-            path: origin.to_string(),
-            line,
-            column,
-            message,
-        };
         let mut rdr = csv::ReaderBuilder::new()
             .flexible(false)
             .trim(csv::Trim::All)
             .comment(Some(b'#'))
             .from_reader(text.as_bytes());
-        let headers = rdr
-            .headers()
-            .map_err(|e| err(1, 1, format!("cannot read the header: {e}")))?
-            .clone();
-        let known = columns();
-        let mut col = std::collections::HashMap::new();
-        for (i, h) in headers.iter().enumerate() {
-            if !known.iter().any(|k| k == h) {
-                return Err(err(
-                    1,
-                    i + 1,
-                    format!(
-                        "unknown column {h:?}; the format's columns are {}",
-                        known.join(", ")
-                    ),
-                ));
-            }
-            if col.insert(h.to_string(), i).is_some() {
-                return Err(err(1, i + 1, format!("column {h:?} appears twice")));
-            }
-        }
-        for required in ["design", "leg_length_m", "source"] {
-            if !col.contains_key(required) {
-                return Err(err(
-                    1,
-                    headers.len() + 1,
-                    format!("missing required column {required:?}"),
-                ));
-            }
-        }
+        let col = read_columns(&mut rdr, origin)?;
         let mut trials = Vec::new();
         for rec in rdr.records() {
             let rec = rec.map_err(|e| {
                 let line = e.position().map(|p| p.line()).unwrap_or(0);
-                err(line, 1, format!("malformed row: {e}"))
+                trials_error(origin, line, 1, format!("malformed row: {e}"))
             })?;
-            let line = rec.position().map(|p| p.line()).unwrap_or(0);
-            let cell = |name: &str| -> Option<(usize, &str)> {
-                col.get(name)
-                    .and_then(|&i| rec.get(i).map(|v| (i + 1, v)))
-                    .filter(|(_, v)| !v.is_empty())
+            let row = TrialRow {
+                origin,
+                col: &col,
+                line: rec.position().map(|p| p.line()).unwrap_or(0),
+                rec: &rec,
             };
-            let number = |name: &str,
-                          ok: &dyn Fn(f64) -> bool,
-                          why: &str|
-             -> Result<Option<f64>, GapError> {
-                match cell(name) {
-                    None => Ok(None),
-                    Some((c, v)) => {
-                        let x: f64 = v
-                            .parse()
-                            .map_err(|_| err(line, c, format!("{name}: {v:?} is not a number")))?;
-                        if !x.is_finite() || !ok(x) {
-                            return Err(err(line, c, format!("{name}: {v} {why}")));
-                        }
-                        Ok(Some(x))
-                    }
-                }
-            };
-            let design = match cell("design") {
-                Some((_, v)) => v.to_string(),
-                None => {
-                    return Err(err(
-                        line,
-                        col["design"] + 1,
-                        "design: empty; name a bundled design or a design TOML path".into(),
-                    ));
-                }
-            };
-            let leg_length_m = number(
-                "leg_length_m",
-                &|x| (1e-3..=100.0).contains(&x),
-                "must be a leg length in [0.001, 100] m",
-            )?
-            .ok_or_else(|| {
-                err(
-                    line,
-                    col["leg_length_m"] + 1,
-                    "leg_length_m: empty; every trial needs its leg length".into(),
-                )
-            })?;
-            let mass_law = match cell("mass_law") {
-                None => None,
-                Some((c, v)) => Some(match v {
-                    "l2" => MassLaw::L2,
-                    "l3" => MassLaw::L3,
-                    _ => return Err(err(line, c, format!("mass_law: {v:?}; expected l2 or l3"))),
-                }),
-            };
-            let contact = match cell("contact") {
-                None => None,
-                Some((c, v)) => Some(match v {
-                    "similar" => ContactScaling::Similar,
-                    "fixed-material" => ContactScaling::FixedMaterial,
-                    _ => {
-                        return Err(err(
-                            line,
-                            c,
-                            format!("contact: {v:?}; expected similar or fixed-material"),
-                        ));
-                    }
-                }),
-            };
-            let positive = |x: f64| x > 0.0;
-            let mass_kg = number("mass_kg", &positive, "must be > 0 kg")?;
-            let frequency_hz = number("frequency_hz", &positive, "must be > 0 Hz")?;
-            let amplitude_deg = number(
-                "amplitude_deg",
-                &|x| x > 0.0 && x < 90.0,
-                "must be in (0, 90) deg",
-            )?;
-            let torque_limit_nm = number("torque_limit_nm", &positive, "must be > 0 N·m")?;
-            let torque_nm = number("torque_nm", &positive, "must be > 0 N·m")?;
-            let slope_deg = number("slope_deg", &|x| x.abs() <= 45.0, "must be within ±45 deg")?;
-            let mut measured = [None; 8];
-            for m in Metric::ALL {
-                let name = m.column();
-                let ok = |x: f64| m.signed() || x >= 0.0;
-                let value = number(name, &ok, "must be ≥ 0")?;
-                let sd_name = format!("{name}_sd");
-                let sd = number(&sd_name, &positive, "must be > 0 (a standard deviation)")?;
-                match (value, sd) {
-                    (Some(v), sd) => measured[m.index()] = Some(Measurement { value: v, sd }),
-                    (None, Some(_)) => {
-                        let c = col[&sd_name] + 1;
-                        return Err(err(line, c, format!("{sd_name} given without {name}")));
-                    }
-                    (None, None) => {}
-                }
-            }
-            let source = cell("source").map(|(_, v)| v.to_string()).ok_or_else(|| {
-                err(
-                    line,
-                    col["source"] + 1,
-                    "source: empty; every trial must say where its numbers come from".into(),
-                )
-            })?;
-            trials.push(Trial {
-                line,
-                label: cell("label")
-                    .map(|(_, v)| v.to_string())
-                    .unwrap_or_default(),
-                design,
-                leg_length_m,
-                mass_kg,
-                mass_law,
-                contact,
-                frequency_hz,
-                amplitude_deg,
-                torque_limit_nm,
-                torque_nm,
-                slope_deg,
-                measured,
-                trajectory: cell("trajectory").map(|(_, v)| v.to_string()),
-                source,
-            });
+            trials.push(row.trial()?);
         }
         if trials.is_empty() {
-            return Err(err(
+            return Err(trials_error(
+                origin,
                 1,
                 1,
                 "no trials: the file has a header but no rows".into(),
@@ -391,45 +244,281 @@ impl TrialSet {
         })
     }
 
-    /// The trials as CSV, in the format [`TrialSet::parse`] reads.
+    /// The trials as CSV, in the format [`TrialSet::parse`] reads. Writing to memory fails
+    /// only on a row of another length than the header, which [`TrialSet::csv_for`]
+    /// reports; this gives the text written up to there.
     pub fn to_csv(&self) -> String {
+        self.write_csv().0
+    }
+
+    /// The trials as CSV for the file `path`; a write error names that file.
+    pub fn csv_for(&self, path: &Path) -> Result<String, GapError> {
+        let (text, result) = self.write_csv();
+        result.map(|()| text).map_err(|e| GapError::File {
+            path: path.display().to_string(),
+            message: format!("cannot write the trials as CSV: {e}"),
+        })
+    }
+
+    /// The CSV text written, and the first write error (the rows after it are not written).
+    fn write_csv(&self) -> (String, Result<(), csv::Error>) {
         let mut w = csv::WriterBuilder::new().from_writer(Vec::new());
-        let _ = w.write_record(columns());
-        let f = |x: Option<f64>| x.map(fmt_number).unwrap_or_default();
-        for t in &self.trials {
-            let mut row = vec![
-                t.label.clone(),
-                t.design.clone(),
-                fmt_number(t.leg_length_m),
-                f(t.mass_kg),
-                t.mass_law
-                    .map(|m| match m {
-                        MassLaw::L2 => "l2".to_string(),
-                        MassLaw::L3 => "l3".to_string(),
-                    })
-                    .unwrap_or_default(),
-                t.contact
-                    .map(|c| match c {
-                        ContactScaling::Similar => "similar".to_string(),
-                        ContactScaling::FixedMaterial => "fixed-material".to_string(),
-                    })
-                    .unwrap_or_default(),
-                f(t.frequency_hz),
-                f(t.amplitude_deg),
-                f(t.torque_limit_nm),
-                f(t.torque_nm),
-                f(t.slope_deg),
-            ];
-            for m in Metric::ALL {
-                let meas = t.measured(m);
-                row.push(f(meas.map(|x| x.value)));
-                row.push(f(meas.and_then(|x| x.sd)));
-            }
-            row.push(t.trajectory.clone().unwrap_or_default());
-            row.push(t.source.clone());
-            let _ = w.write_record(&row);
+        let result = std::iter::once(w.write_record(columns()))
+            .chain(self.trials.iter().map(|t| w.write_record(trial_row(t))))
+            .collect::<Result<(), csv::Error>>();
+        let text = w
+            .into_inner()
+            .map(|v| String::from_utf8(v).unwrap_or_default())
+            .unwrap_or_default();
+        (text, result)
+    }
+}
+
+/// A trial's cells, in the order of [`columns`].
+fn trial_row(t: &Trial) -> Vec<String> {
+    let f = |x: Option<f64>| x.map(fmt_number).unwrap_or_default();
+    let mut row = vec![
+        t.label.clone(),
+        t.design.clone(),
+        fmt_number(t.leg_length_m),
+        f(t.mass_kg),
+        t.mass_law
+            .map(|m| match m {
+                MassLaw::L2 => "l2".to_string(),
+                MassLaw::L3 => "l3".to_string(),
+            })
+            .unwrap_or_default(),
+        t.contact
+            .map(|c| match c {
+                ContactScaling::Similar => "similar".to_string(),
+                ContactScaling::FixedMaterial => "fixed-material".to_string(),
+            })
+            .unwrap_or_default(),
+        f(t.frequency_hz),
+        f(t.amplitude_deg),
+        f(t.torque_limit_nm),
+        f(t.torque_nm),
+        f(t.slope_deg),
+    ];
+    for m in Metric::ALL {
+        let meas = t.measured(m);
+        row.push(f(meas.map(|x| x.value)));
+        row.push(f(meas.and_then(|x| x.sd)));
+    }
+    row.push(t.trajectory.clone().unwrap_or_default());
+    row.push(t.source.clone());
+    row
+}
+
+fn trials_error(origin: &str, line: u64, column: usize, message: String) -> GapError {
+    GapError::Trials {
+        path: origin.to_string(),
+        line,
+        column,
+        message,
+    }
+}
+
+/// The header: every column known, none twice, the required ones there. Returns each
+/// column's index.
+fn read_columns(
+    rdr: &mut csv::Reader<&[u8]>,
+    origin: &str,
+) -> Result<std::collections::HashMap<String, usize>, GapError> {
+    let err =
+        |line: u64, column: usize, message: String| trials_error(origin, line, column, message);
+    let headers = rdr
+        .headers()
+        .map_err(|e| err(1, 1, format!("cannot read the header: {e}")))?
+        .clone();
+    let known = columns();
+    let mut col = std::collections::HashMap::new();
+    for (i, h) in headers.iter().enumerate() {
+        if !known.iter().any(|k| k == h) {
+            return Err(err(
+                1,
+                i + 1,
+                format!(
+                    "unknown column {h:?}; the format's columns are {}",
+                    known.join(", ")
+                ),
+            ));
         }
-        String::from_utf8(w.into_inner().unwrap_or_default()).unwrap_or_default()
+        if col.insert(h.to_string(), i).is_some() {
+            return Err(err(1, i + 1, format!("column {h:?} appears twice")));
+        }
+    }
+    for required in ["design", "leg_length_m", "source"] {
+        if !col.contains_key(required) {
+            return Err(err(
+                1,
+                headers.len() + 1,
+                format!("missing required column {required:?}"),
+            ));
+        }
+    }
+    Ok(col)
+}
+
+/// One data row of a trials file.
+struct TrialRow<'a> {
+    origin: &'a str,
+    col: &'a std::collections::HashMap<String, usize>,
+    rec: &'a csv::StringRecord,
+    line: u64,
+}
+
+impl TrialRow<'_> {
+    fn err(&self, column: usize, message: String) -> GapError {
+        trials_error(self.origin, self.line, column, message)
+    }
+
+    /// A non-empty cell with its 1-based column.
+    fn cell(&self, name: &str) -> Option<(usize, &str)> {
+        self.col
+            .get(name)
+            .and_then(|&i| self.rec.get(i).map(|v| (i + 1, v)))
+            .filter(|(_, v)| !v.is_empty())
+    }
+
+    /// A numeric cell, checked by `ok` (`why` says what it must be).
+    fn number(
+        &self,
+        name: &str,
+        ok: &dyn Fn(f64) -> bool,
+        why: &str,
+    ) -> Result<Option<f64>, GapError> {
+        match self.cell(name) {
+            None => Ok(None),
+            Some((c, v)) => {
+                let x: f64 = v
+                    .parse()
+                    .map_err(|_| self.err(c, format!("{name}: {v:?} is not a number")))?;
+                if !x.is_finite() || !ok(x) {
+                    return Err(self.err(c, format!("{name}: {v} {why}")));
+                }
+                Ok(Some(x))
+            }
+        }
+    }
+
+    /// A required cell (its column is there, `read_columns` checked) that is empty.
+    fn empty(&self, name: &str, message: &str) -> GapError {
+        self.err(self.col[name] + 1, message.into())
+    }
+
+    fn trial(&self) -> Result<Trial, GapError> {
+        let design = match self.cell("design") {
+            Some((_, v)) => v.to_string(),
+            None => {
+                return Err(self.empty(
+                    "design",
+                    "design: empty; name a bundled design or a design TOML path",
+                ));
+            }
+        };
+        let leg_length_m = self
+            .number(
+                "leg_length_m",
+                &|x| (1e-3..=100.0).contains(&x),
+                "must be a leg length in [0.001, 100] m",
+            )?
+            .ok_or_else(|| {
+                self.empty(
+                    "leg_length_m",
+                    "leg_length_m: empty; every trial needs its leg length",
+                )
+            })?;
+        let (mass_law, contact) = self.laws()?;
+        let positive = |x: f64| x > 0.0;
+        let mass_kg = self.number("mass_kg", &positive, "must be > 0 kg")?;
+        let frequency_hz = self.number("frequency_hz", &positive, "must be > 0 Hz")?;
+        let amplitude_deg = self.number(
+            "amplitude_deg",
+            &|x| x > 0.0 && x < 90.0,
+            "must be in (0, 90) deg",
+        )?;
+        let torque_limit_nm = self.number("torque_limit_nm", &positive, "must be > 0 N·m")?;
+        let torque_nm = self.number("torque_nm", &positive, "must be > 0 N·m")?;
+        let slope_deg = self.number("slope_deg", &|x| x.abs() <= 45.0, "must be within ±45 deg")?;
+        let measured = self.measurements()?;
+        let source = self
+            .cell("source")
+            .map(|(_, v)| v.to_string())
+            .ok_or_else(|| {
+                self.empty(
+                    "source",
+                    "source: empty; every trial must say where its numbers come from",
+                )
+            })?;
+        Ok(Trial {
+            line: self.line,
+            label: self
+                .cell("label")
+                .map(|(_, v)| v.to_string())
+                .unwrap_or_default(),
+            design,
+            leg_length_m,
+            mass_kg,
+            mass_law,
+            contact,
+            frequency_hz,
+            amplitude_deg,
+            torque_limit_nm,
+            torque_nm,
+            slope_deg,
+            measured,
+            trajectory: self.cell("trajectory").map(|(_, v)| v.to_string()),
+            source,
+        })
+    }
+
+    /// The mass law and contact scaling of a resized trial.
+    fn laws(&self) -> Result<(Option<MassLaw>, Option<ContactScaling>), GapError> {
+        let mass_law = match self.cell("mass_law") {
+            None => None,
+            Some((c, v)) => Some(match v {
+                "l2" => MassLaw::L2,
+                "l3" => MassLaw::L3,
+                _ => return Err(self.err(c, format!("mass_law: {v:?}; expected l2 or l3"))),
+            }),
+        };
+        let contact = match self.cell("contact") {
+            None => None,
+            Some((c, v)) => Some(match v {
+                "similar" => ContactScaling::Similar,
+                "fixed-material" => ContactScaling::FixedMaterial,
+                _ => {
+                    return Err(self.err(
+                        c,
+                        format!("contact: {v:?}; expected similar or fixed-material"),
+                    ));
+                }
+            }),
+        };
+        Ok((mass_law, contact))
+    }
+
+    /// The measured metrics and their standard deviations (an sd needs its value).
+    fn measurements(&self) -> Result<[Option<Measurement>; 8], GapError> {
+        let positive = |x: f64| x > 0.0;
+        let mut measured = [None; 8];
+        for m in Metric::ALL {
+            let name = m.column();
+            let ok = |x: f64| m.signed() || x >= 0.0;
+            let value = self.number(name, &ok, "must be ≥ 0")?;
+            let sd_name = format!("{name}_sd");
+            let sd = self.number(&sd_name, &positive, "must be > 0 (a standard deviation)")?;
+            match (value, sd) {
+                (Some(v), sd) => measured[m.index()] = Some(Measurement { value: v, sd }),
+                (None, Some(_)) => {
+                    let c = self.col[&sd_name] + 1;
+                    return Err(self.err(c, format!("{sd_name} given without {name}")));
+                }
+                (None, None) => {}
+            }
+        }
+        Ok(measured)
     }
 }
 

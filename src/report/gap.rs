@@ -610,6 +610,15 @@ pub fn benchmark_md(b: &BenchmarkSummary, rows: &[CaseRow], command: &str) -> St
          declares uncertain (friction_coefficient ↔ contact.friction_mu) counts as named when \
          that parameter is.\n"
     );
+    scores_md(&mut o, b);
+    thresholds_md(&mut o, b);
+    confusions_md(&mut o, b);
+    outside_cases_md(&mut o, rows);
+    o
+}
+
+/// The score table.
+fn scores_md(o: &mut String, b: &BenchmarkSummary) {
     let _ = writeln!(o, "## Scores\n");
     let _ = writeln!(
         o,
@@ -630,6 +639,10 @@ pub fn benchmark_md(b: &BenchmarkSummary, rows: &[CaseRow], command: &str) -> St
             sc.target
         );
     }
+}
+
+/// The identification thresholds, one column per noise level.
+fn thresholds_md(o: &mut String, b: &BenchmarkSummary) {
     let _ = writeln!(
         o,
         "\n## Identification thresholds (SI, {} at 1×: against the other effects, each uncertain parameter, and the recalibration of all of them, confirmed with walks; an effect the design calibrates as a parameter: against the other effects)\n",
@@ -660,6 +673,10 @@ pub fn benchmark_md(b: &BenchmarkSummary, rows: &[CaseRow], command: &str) -> St
         }
         let _ = writeln!(o);
     }
+}
+
+/// The confusion matrices.
+fn confusions_md(o: &mut String, b: &BenchmarkSummary) {
     for c in &b.confusions {
         let _ = writeln!(
             o,
@@ -684,6 +701,10 @@ pub fn benchmark_md(b: &BenchmarkSummary, rows: &[CaseRow], command: &str) -> St
             let _ = writeln!(o);
         }
     }
+}
+
+/// Cases outside the single-effect world (parameter errors, Drake, pairs), one per line.
+fn outside_cases_md(o: &mut String, rows: &[CaseRow]) {
     let listed: Vec<&CaseRow> = rows
         .iter()
         .filter(|r| r.kind == "parameter" || r.kind == "drake" || r.kind == "pair")
@@ -718,29 +739,7 @@ pub fn benchmark_md(b: &BenchmarkSummary, rows: &[CaseRow], command: &str) -> St
                 if truth.is_empty() { "none" } else { &truth },
                 r.answer,
                 if named.is_empty() { "–" } else { &named },
-                if r.intervals.is_empty() {
-                    "–".to_string()
-                } else {
-                    r.intervals
-                        .split(';')
-                        .map(|iv| match iv.split_once('=') {
-                            Some((k, v)) => {
-                                let (lo, hi) = v.split_once("..").unwrap_or((v, v));
-                                let f = |x: &str| {
-                                    x.parse::<f64>().map(sig).unwrap_or_else(|_| x.into())
-                                };
-                                format!(
-                                    "{} [{}, {}]",
-                                    k.rsplit(':').next().unwrap_or(k),
-                                    f(lo),
-                                    f(hi)
-                                )
-                            }
-                            None => iv.to_string(),
-                        })
-                        .collect::<Vec<_>>()
-                        .join("; ")
-                },
+                intervals_cell(&r.intervals),
                 r.gap_before,
                 r.gap_after
                     .map(|g| format!("{g:.2}"))
@@ -748,7 +747,32 @@ pub fn benchmark_md(b: &BenchmarkSummary, rows: &[CaseRow], command: &str) -> St
             );
         }
     }
-    o
+}
+
+/// Named intervals `knob=lo..hi;…` as `knob [lo, hi]; …` (the parameter's path without
+/// its design, values to a few significant digits); `–` when none.
+fn intervals_cell(intervals: &str) -> String {
+    if intervals.is_empty() {
+        "–".to_string()
+    } else {
+        intervals
+            .split(';')
+            .map(|iv| match iv.split_once('=') {
+                Some((k, v)) => {
+                    let (lo, hi) = v.split_once("..").unwrap_or((v, v));
+                    let f = |x: &str| x.parse::<f64>().map(sig).unwrap_or_else(|_| x.into());
+                    format!(
+                        "{} [{}, {}]",
+                        k.rsplit(':').next().unwrap_or(k),
+                        f(lo),
+                        f(hi)
+                    )
+                }
+                None => iv.to_string(),
+            })
+            .collect::<Vec<_>>()
+            .join("; ")
+    }
 }
 
 /// The benchmark's confusion matrices as heat maps, one panel each (SVG).

@@ -19,7 +19,7 @@ use serde::Serialize;
 
 use super::StudyError;
 use super::table3::{Table3Point, Table3Row};
-use crate::motors::{MotorCatalogue, Quantity, SizeVariable, SourceKind};
+use crate::motors::{Actuator, MotorCatalogue, Quantity, SizeVariable, SourceKind};
 use crate::sim::{ContactScaling, MassLaw};
 
 /// How actuator size follows robot size.
@@ -146,36 +146,7 @@ pub fn torque_check(
     anchor_leg_length_m: Option<f64>,
     design_mass_at: &dyn Fn(f64) -> f64,
 ) -> Result<TorqueCheck, StudyError> {
-    let (actuator, voltage, l0) = match anchor {
-        Some((id, v)) => {
-            let a = catalogue
-                .actuator(id)
-                .ok_or_else(|| StudyError::InvalidOption {
-                    option: "actuator".into(),
-                    reason: format!(
-                        "no actuator `{id}` in the motor catalogue (dataset/motors/actuators.toml)"
-                    ),
-                })?;
-            let l0 = anchor_leg_length_m.ok_or_else(|| StudyError::InvalidOption {
-                option: "anchor_leg_length".into(),
-                reason: "an explicit actuator needs the leg length it drives".into(),
-            })?;
-            (a, v, l0)
-        }
-        None => {
-            let (an, a, _) = catalogue.anchor_stall_torque(&row.design).ok_or_else(|| {
-                StudyError::InvalidOption {
-                    option: "actuator".into(),
-                    reason: format!(
-                        "design `{}` has no anchor actuator in dataset/motors/anchors.toml \
-                         (its motor is not catalogued); name one with --actuator ID",
-                        row.design
-                    ),
-                }
-            })?;
-            (a, Some(an.voltage_v), an.leg_length_m)
-        }
-    };
+    let (actuator, voltage, l0) = resolve_anchor(row, catalogue, anchor, anchor_leg_length_m)?;
     let tau0 = actuator
         .stall_torque_at(voltage)
         .ok_or_else(|| StudyError::InvalidOption {
@@ -210,28 +181,7 @@ pub fn torque_check(
             .iter()
             .map(|law| {
                 let k = law.exponent;
-                let p = match (bridge, law.size_variable, law.quantity) {
-                    (Bridge::IsometricActuator, SizeVariable::MotorLength, Quantity::Torque) => k,
-                    (Bridge::IsometricActuator, SizeVariable::MotorLength, Quantity::Force) => {
-                        k + 1.0
-                    }
-                    (Bridge::IsometricActuator, SizeVariable::MotorMass, Quantity::Torque) => {
-                        3.0 * k
-                    }
-                    (Bridge::IsometricActuator, SizeVariable::MotorMass, Quantity::Force) => {
-                        3.0 * k + 1.0
-                    }
-                    (Bridge::FixedMassFraction, SizeVariable::MotorLength, Quantity::Torque) => {
-                        e * k / 3.0
-                    }
-                    (Bridge::FixedMassFraction, SizeVariable::MotorLength, Quantity::Force) => {
-                        e * (k + 1.0) / 3.0
-                    }
-                    (Bridge::FixedMassFraction, SizeVariable::MotorMass, Quantity::Torque) => e * k,
-                    (Bridge::FixedMassFraction, SizeVariable::MotorMass, Quantity::Force) => {
-                        e * k + e / 3.0
-                    }
-                };
+                let p = bridge_exponent(bridge, law.size_variable, law.quantity, k, e);
                 (
                     law.id.clone(),
                     format!("{:?}", law.basis).to_lowercase(),
@@ -291,6 +241,70 @@ pub fn torque_check(
         actuator_fit_n: n_fit,
         bridges,
     })
+}
+
+/// The actuator, voltage and leg length the laws are pinned at: the one named, else the
+/// catalogue's anchor of the design.
+fn resolve_anchor<'c>(
+    row: &Table3Row,
+    catalogue: &'c MotorCatalogue,
+    anchor: Option<(&str, Option<f64>)>,
+    anchor_leg_length_m: Option<f64>,
+) -> Result<(&'c Actuator, Option<f64>, f64), StudyError> {
+    let found = match anchor {
+        Some((id, v)) => {
+            let a = catalogue
+                .actuator(id)
+                .ok_or_else(|| StudyError::InvalidOption {
+                    option: "actuator".into(),
+                    reason: format!(
+                        "no actuator `{id}` in the motor catalogue (dataset/motors/actuators.toml)"
+                    ),
+                })?;
+            let l0 = anchor_leg_length_m.ok_or_else(|| StudyError::InvalidOption {
+                option: "anchor_leg_length".into(),
+                reason: "an explicit actuator needs the leg length it drives".into(),
+            })?;
+            (a, v, l0)
+        }
+        None => {
+            let (an, a, _) = catalogue.anchor_stall_torque(&row.design).ok_or_else(|| {
+                StudyError::InvalidOption {
+                    option: "actuator".into(),
+                    reason: format!(
+                        "design `{}` has no anchor actuator in dataset/motors/anchors.toml \
+                     (its motor is not catalogued); name one with --actuator ID",
+                        row.design
+                    ),
+                }
+            })?;
+            (a, Some(an.voltage_v), an.leg_length_m)
+        }
+    };
+    Ok(found)
+}
+
+/// The exponent of available torque in leg length that a motor law of exponent `k` gives
+/// under a bridge (`e`: the mass law's exponent).
+fn bridge_exponent(
+    bridge: Bridge,
+    size_variable: SizeVariable,
+    quantity: Quantity,
+    k: f64,
+    e: f64,
+) -> f64 {
+    match (bridge, size_variable, quantity) {
+        (Bridge::IsometricActuator, SizeVariable::MotorLength, Quantity::Torque) => k,
+        (Bridge::IsometricActuator, SizeVariable::MotorLength, Quantity::Force) => k + 1.0,
+        (Bridge::IsometricActuator, SizeVariable::MotorMass, Quantity::Torque) => 3.0 * k,
+        (Bridge::IsometricActuator, SizeVariable::MotorMass, Quantity::Force) => 3.0 * k + 1.0,
+        (Bridge::FixedMassFraction, SizeVariable::MotorLength, Quantity::Torque) => e * k / 3.0,
+        (Bridge::FixedMassFraction, SizeVariable::MotorLength, Quantity::Force) => {
+            e * (k + 1.0) / 3.0
+        }
+        (Bridge::FixedMassFraction, SizeVariable::MotorMass, Quantity::Torque) => e * k,
+        (Bridge::FixedMassFraction, SizeVariable::MotorMass, Quantity::Force) => e * k + e / 3.0,
+    }
 }
 
 #[allow(clippy::too_many_arguments)]
