@@ -36,7 +36,12 @@ pub struct DiffArgs {
 
 pub fn diff(a: &DiffArgs) -> anyhow::Result<ExitCode> {
     let ds = Dataset::locate(a.dataset.as_deref())?;
-    let d = robot_survey::diff::diff(&ds, a.against.as_deref(), a.method.into(), a.confidence)?;
+    let d = robot_survey::analysis::release_diff::diff(
+        &ds,
+        a.against.as_deref(),
+        a.method.into(),
+        a.confidence,
+    )?;
     print(&match a.format {
         Format::Json => report::json(&d)?,
         Format::Md => report::diff_md(&d),

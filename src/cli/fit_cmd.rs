@@ -5,10 +5,10 @@ use std::process::ExitCode;
 
 use anyhow::Context;
 use clap::{Args, ValueEnum};
+use robot_survey::analysis::table2::{self, Group};
 use robot_survey::dataset::Dataset;
 use robot_survey::regression::Method;
 use robot_survey::report::{self, Format};
-use robot_survey::survey::{self, Group};
 
 use super::{DatasetArgs, print};
 
@@ -84,7 +84,7 @@ pub fn fit(a: &FitArgs) -> anyhow::Result<ExitCode> {
     let table = ds.table(a.data.release.as_deref())?;
     if let Some(class) = &a.explain {
         let g = parse_group(class)?;
-        let ex = survey::explain(&table, g, a.method.into())?;
+        let ex = table2::explain(&table, g, a.method.into())?;
         print(&match a.format {
             Format::Json => report::json(&ex)?,
             _ => report::explain_text(&ex),
@@ -98,7 +98,7 @@ pub fn fit(a: &FitArgs) -> anyhow::Result<ExitCode> {
             seed: a.seed,
             level: a.confidence,
         });
-    let t2 = survey::table2_with_bootstrap(&table, a.method.into(), a.confidence, bootstrap)?;
+    let t2 = table2::table2_with_bootstrap(&table, a.method.into(), a.confidence, bootstrap)?;
     if let Some(dir) = &a.out {
         std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
         let mut written = Vec::new();
@@ -186,14 +186,14 @@ pub struct PredictArgs {
 #[derive(serde::Serialize)]
 struct PredictionWithTorque<'a> {
     #[serde(flatten)]
-    prediction: &'a robot_survey::predict::Prediction,
+    prediction: &'a robot_survey::analysis::prediction::Prediction,
     torque: &'a robot_survey::study::torque_need::TorqueNeed,
 }
 
 fn torque_need(
     a: &PredictArgs,
     design: &str,
-    pred: &robot_survey::predict::Prediction,
+    pred: &robot_survey::analysis::prediction::Prediction,
 ) -> anyhow::Result<Option<robot_survey::study::torque_need::TorqueNeed>> {
     let Some(l) = a.leg_length else {
         return Ok(None);
@@ -217,7 +217,7 @@ fn torque_need(
 }
 
 pub fn predict(a: &PredictArgs) -> anyhow::Result<ExitCode> {
-    use robot_survey::predict as p;
+    use robot_survey::analysis::prediction as p;
     let ds = Dataset::locate(a.data.dataset.as_deref())?;
     let table = ds.table(a.data.release.as_deref())?;
     let class = parse_group(&a.class)?;
@@ -316,13 +316,13 @@ pub enum TestCommand {
     },
 }
 
-fn parse_var(s: &str) -> anyhow::Result<survey::Var> {
-    survey::Var::parse(s)
+fn parse_var(s: &str) -> anyhow::Result<table2::Var> {
+    table2::Var::parse(s)
         .with_context(|| format!("unknown variable `{s}` (one of: leg_length, body_length, mass)"))
 }
 
 pub fn test(a: &TestArgs) -> anyhow::Result<ExitCode> {
-    use robot_survey::inference;
+    use robot_survey::analysis::inference;
     let common = match &a.test {
         TestCommand::Slope { common, .. } | TestCommand::CommonSlope { common, .. } => common,
     };
@@ -383,7 +383,7 @@ pub struct LawsArgs {
 pub fn laws(a: &LawsArgs) -> anyhow::Result<ExitCode> {
     let ds = Dataset::locate(a.data.dataset.as_deref())?;
     let table = ds.table(a.data.release.as_deref())?;
-    let t = robot_survey::laws::law_table(&ds, &table, a.confidence)?;
+    let t = robot_survey::analysis::laws::law_table(&ds, &table, a.confidence)?;
     print(&match a.format {
         Format::Json => report::json(&t)?,
         _ => report::laws_md(&t),

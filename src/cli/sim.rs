@@ -293,7 +293,9 @@ fn scale(a: &ScaleArgs) -> anyhow::Result<ExitCode> {
     );
     bar.set_message(format!("simulating {}", a.run.design));
     let study =
-        robot_survey::scaling::scaling_study(&design, &a.leg_lengths, &base, &|| bar.inc(1))?;
+        robot_survey::study::scaling::scaling_study(&design, &a.leg_lengths, &base, &|| {
+            bar.inc(1)
+        })?;
     bar.finish_and_clear();
     if let Some(path) = &a.plot {
         report::plot::draw_panels(path, &report::plot::scaling_panels(&study), (1200, 520))?;

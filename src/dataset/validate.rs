@@ -13,8 +13,10 @@ use serde::Serialize;
 use super::Dataset;
 use super::problem::{Problem, Rule, Severity};
 use super::record::{Robot, RobotClass, SourceKind, Value};
-use super::release::{self, parse_semver};
+use super::release::{self, SurveyTable, parse_semver};
+use super::selection::{Group, TABLE2_PAIRS, log_points};
 use super::vocabulary::FieldType;
+use crate::regression::studentized_outliers;
 
 /// Standard gravity [m/s²], for Froude numbers.
 pub const G_MPS2: f64 = 9.80665;
@@ -611,21 +613,79 @@ fn check_duplicates(ds: &Dataset, problems: &mut Vec<Problem>) {
 
 fn check_outliers(ds: &Dataset, problems: &mut Vec<Problem>) {
     let table = release::compile(ds);
-    for o in crate::survey::outliers(&table, OUTLIER_T) {
-        let Some((rel, _)) = ds.robots.iter().find(|(_, r)| r.id == o.id) else {
+    let locate = |id: &str| {
+        let (rel, _) = ds.robots.iter().find(|(_, r)| r.id == id)?;
+        Some((ds.files.display(rel), None))
+    };
+    push_outliers(
+        &table,
+        locate,
+        "; check the values and their sources",
+        problems,
+    );
+}
+
+/// A fitted robot far from its class line in one Table 2 relation.
+struct Outlier {
+    id: String,
+    class: Group,
+    x: &'static str,
+    y: &'static str,
+    y_field: &'static str,
+    /// Externally studentized (leave-one-out) residual of the OLS log–log fit.
+    t: f64,
+}
+
+/// Fitted robots whose leave-one-out studentized residual exceeds [`OUTLIER_T`] in any
+/// Table 2 relation of their class (classes with fewer than 5 robots are skipped).
+fn outliers(table: &SurveyTable) -> Vec<Outlier> {
+    let mut out = Vec::new();
+    for class in RobotClass::FITTED {
+        let g = Group::Class(class);
+        for (x, y) in TABLE2_PAIRS {
+            // Unusable values (non-positive, …) are the other rules' business.
+            let Ok(p) = log_points(table, g, x, y) else {
+                continue;
+            };
+            for (i, t) in studentized_outliers(&p.lx, &p.ly, OUTLIER_T) {
+                out.push(Outlier {
+                    id: p.ids[i].clone(),
+                    class: g,
+                    x: x.as_str(),
+                    y: y.as_str(),
+                    y_field: y.field(),
+                    t,
+                });
+            }
+        }
+    }
+    out
+}
+
+/// One warning per outlier of `table`, at the file (and line) `locate` gives its robot
+/// (none: not reported); `advice` ends the message.
+fn push_outliers(
+    table: &SurveyTable,
+    locate: impl Fn(&str) -> Option<(String, Option<usize>)>,
+    advice: &str,
+    problems: &mut Vec<Problem>,
+) {
+    for o in outliers(table) {
+        let Some((file, line)) = locate(&o.id) else {
             continue;
         };
         problems.push(
             Problem::warning(
-                &ds.files.display(rel),
+                &file,
                 Rule::Outlier,
                 format!(
-                    "{} vs {}: leave-one-out studentized residual {:+.2} against the {} fit (|t| > {OUTLIER_T}); check the values and their sources",
+                    "{} vs {}: leave-one-out studentized residual {:+.2} against the {} fit (|t| > {OUTLIER_T}){advice}",
                     o.y, o.x, o.t, o.class
                 ),
             )
             .robot(o.id.clone())
-            .field(format!("values.{}", o.y_field)),
+            .field(format!("values.{}", o.y_field))
+            .line(line),
         );
     }
 }
@@ -915,22 +975,11 @@ pub fn validate_release_rows(
             problems.push(p);
         }
     }
-    for o in crate::survey::outliers(&table, OUTLIER_T) {
-        let line = table.rows.iter().position(|r| r.id == o.id).map(|i| i + 2);
-        problems.push(
-            Problem::warning(
-                &file,
-                Rule::Outlier,
-                format!(
-                    "{} vs {}: leave-one-out studentized residual {:+.2} against the {} fit (|t| > {OUTLIER_T})",
-                    o.y, o.x, o.t, o.class
-                ),
-            )
-            .robot(o.id.clone())
-            .field(format!("values.{}", o.y_field))
-            .line(line),
-        );
-    }
+    let locate = |id: &str| {
+        let line = table.rows.iter().position(|r| r.id == id).map(|i| i + 2);
+        Some((file.clone(), line))
+    };
+    push_outliers(&table, locate, "", &mut problems);
     problems.sort_by(|a, b| {
         (a.severity, a.line, &a.field, a.rule).cmp(&(b.severity, b.line, &b.field, b.rule))
     });

@@ -11,9 +11,9 @@
 
 use std::fmt::Write as _;
 
+use crate::analysis::table2::{Group, PowerLawRow, TABLE2_PAIRS, Table2, Var, log_points};
 use crate::dataset::{RobotClass, SurveyRow, SurveyTable};
 use crate::regression::{self, Method};
-use crate::survey::{Group, PowerLawRow, TABLE2_PAIRS, Table2, Var, log_points};
 
 /// One robot in one panel.
 #[derive(Debug, Clone)]

@@ -7,8 +7,8 @@ use std::sync::Once;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
+use crate::analysis::table2::{Group, Table2, Var, points};
 use crate::dataset::{RobotClass, SurveyTable};
-use crate::survey::{Group, Table2, Var, points};
 
 static FONT: Once = Once::new();
 const FONT_BYTES: &[u8] = include_bytes!("../../assets/fonts/DejaVuSans.ttf");
@@ -313,8 +313,8 @@ pub fn survey_panels(table: &SurveyTable, t2: &Table2) -> Vec<Panel> {
 /// target's prediction and the L² / L³ scaling of the reference.
 pub fn prediction_panel(
     table: &SurveyTable,
-    pred: &crate::predict::Prediction,
-) -> Result<Panel, crate::predict::PredictError> {
+    pred: &crate::analysis::prediction::Prediction,
+) -> Result<Panel, crate::analysis::prediction::PredictError> {
     let all = points(table, Group::All, Var::LegLength, Var::Mass);
     let mut lo = all.iter().map(|p| p.1).fold(f64::INFINITY, f64::min);
     let mut hi = all.iter().map(|p| p.1).fold(f64::NEG_INFINITY, f64::max);
@@ -325,7 +325,8 @@ pub fn prediction_panel(
     let mut series = Vec::new();
     for c in RobotClass::FITTED {
         let g = Group::Class(c);
-        let (law, band) = crate::predict::mass_band(table, g, pred.confidence, [lo, hi])?;
+        let (law, band) =
+            crate::analysis::prediction::mass_band(table, g, pred.confidence, [lo, hi])?;
         series.push(Series {
             label: format!("{} m = {:.3}·L^{:.2}", c.label(), law.a, law.b),
             color: class_color(c),
@@ -387,12 +388,12 @@ pub fn prediction_panel(
 
 /// `survey sim scale --plot`: velocity and peak hip torque against leg length, log–log,
 /// with the fitted power laws.
-pub fn scaling_panels(s: &crate::scaling::ScalingStudy) -> Vec<Panel> {
+pub fn scaling_panels(s: &crate::study::scaling::ScalingStudy) -> Vec<Panel> {
     let walking: Vec<&crate::sim::WalkReport> = s.walks.iter().filter(|w| w.walks).collect();
     let panel = |title: &str,
                  y_label: &str,
                  y: fn(&crate::sim::WalkReport) -> f64,
-                 law: &Option<crate::scaling::StudyLaw>| Panel {
+                 law: &Option<crate::study::scaling::StudyLaw>| Panel {
         title: title.to_string(),
         x_label: "leg length L [m]".into(),
         y_label: y_label.to_string(),

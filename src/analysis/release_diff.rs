@@ -16,13 +16,13 @@ use std::collections::{BTreeMap, BTreeSet};
 
 use serde::Serialize;
 
+use crate::analysis::table2::{DatasetRef, Group, Numeric, TABLE2_PAIRS, Var, fit_group};
 use crate::dataset::release::{self, SurveyRow, SurveyTable, parse_semver};
 use crate::dataset::validate::validate;
 use crate::dataset::{
     Dataset, DatasetError, Datum, FieldType, Problem, Robot, Severity, SourceKind, Value,
 };
 use crate::regression::Method;
-use crate::survey::{DatasetRef, Group, Numeric, TABLE2_PAIRS, Var, fit_group};
 
 /// Columns of the compiled table that identify a robot rather than hold a value.
 const IDENTITY_FIELDS: [&str; 5] = ["id", "name", "class", "fit", "exclusion"];
