@@ -328,7 +328,7 @@ fn walk(a: &WalkArgs) -> anyhow::Result<ExitCode> {
             "{} at L = {:.3} m ({:?})",
             r.design, r.leg_length_m, r.mass_law
         );
-        sim::write_plot_svg(&result.trajectory, &title, path)?;
+        robot_survey::report::walk_plot::write_plot_svg(&result.trajectory, &title, path)?;
         eprintln!("wrote {}", path.display());
     }
     print(&match a.run.format {

@@ -1,5 +1,5 @@
 //! Output formats, in one place: every command's data is rendered here as text, Markdown,
-//! LaTeX (booktabs), CSV or JSON; figures live in [`plot`].
+//! LaTeX (booktabs), CSV or JSON; figures live in [`plot`] (and a walk's in [`walk_plot`]).
 
 mod crosscheck;
 mod diff;
@@ -8,6 +8,7 @@ pub mod html;
 pub mod plot;
 pub mod separation;
 pub mod study;
+pub mod walk_plot;
 
 pub use diff::diff_md;
 

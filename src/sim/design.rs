@@ -1,4 +1,5 @@
-//! Walker designs as data (TOML), their validation, and scaling to another leg length.
+//! Walker designs as data (TOML) and their validation; their scaling to another leg length
+//! is in `similarity.rs`.
 
 use std::path::Path;
 
@@ -11,10 +12,8 @@ use super::contact::ContactParams;
 use super::control::Controller;
 use super::effects::EffectSpec;
 use super::error::SimError;
-use super::model::{FootSection, Hardstop, Leg, Model, State};
-
-/// Standard gravity [m/s²].
-pub const GRAVITY_MPS2: f64 = 9.81;
+use super::model::{FootSection, GRAVITY_MPS2, Hardstop, Leg, Model};
+use super::state::State;
 
 /// Built-in designs: (name, path in the repository, text). Bundled so the binary works
 /// from any directory. The `-ref` designs are ../shared/research/walker-models.json in this
@@ -51,47 +50,6 @@ pub const BUILTIN_DESIGNS: [(&str, &str, &str); 6] = [
         include_str!("../../dataset/walkers/reference/zippy-spherical-ref.toml"),
     ),
 ];
-
-/// How mass follows leg length when a design is scaled.
-#[derive(
-    Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize, Default, clap::ValueEnum,
-)]
-#[serde(rename_all = "lowercase")]
-pub enum MassLaw {
-    /// m ∝ L² (the survey's lower-biped trend).
-    #[default]
-    L2,
-    /// m ∝ L³ (isometric, constant density).
-    L3,
-}
-
-impl MassLaw {
-    pub fn exponent(self) -> f64 {
-        match self {
-            MassLaw::L2 => 2.0,
-            MassLaw::L3 => 3.0,
-        }
-    }
-}
-
-/// Rule for the contact parameters when a design is scaled.
-#[derive(
-    Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize, Default, clap::ValueEnum,
-)]
-#[serde(rename_all = "kebab-case")]
-pub enum ContactScaling {
-    /// Dynamic similarity: the foot's static sinkage stays the same fraction of L and the
-    /// Hunt–Crossley damping the same fraction of the gait's speeds, so E ∝ m/L²
-    /// (since F = πEδ² must scale like m·g with δ ∝ L) and d ∝ L^(−1/2) (d·v constant with
-    /// v ∝ √(gL)); μ unchanged. For m ∝ L² this keeps E fixed. Default: isolates the effect
-    /// of size on the gait from that of foot softness.
-    #[default]
-    Similar,
-    /// Same foot material at every size (what a real robot built of the same rubber has):
-    /// E, d, μ unchanged. For m ∝ L³ large robots then sink relatively deeper
-    /// (δ/L ∝ L^(1/2)).
-    FixedMaterial,
-}
 
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -799,66 +757,6 @@ impl Design {
     /// m·g·L [N·m], the natural torque unit of the design.
     pub fn mgl_nm(&self) -> f64 {
         self.mass.total_mass_kg * GRAVITY_MPS2 * self.geometry.leg_length_m
-    }
-
-    /// The design scaled to leg length `leg_length_m`: lengths ∝ L, mass ∝ L² or L³
-    /// (inertia ∝ m·L² follows from the box fractions), frequencies ∝ L^(−1/2), torques
-    /// ∝ m·L, time step ∝ L^(1/2), contact by `contact_scaling`.
-    pub fn scaled(
-        &self,
-        leg_length_m: f64,
-        mass_law: MassLaw,
-        contact_scaling: ContactScaling,
-    ) -> Result<Design, SimError> {
-        if !(leg_length_m > 0.0 && leg_length_m.is_finite()) {
-            return Err(SimError::InvalidOption {
-                option: "leg_length_m".into(),
-                reason: format!("must be finite and > 0, got {leg_length_m}"),
-            });
-        }
-        let s = leg_length_m / self.geometry.leg_length_m;
-        let mu = s.powf(mass_law.exponent());
-        let time = s.sqrt();
-        let mut d = self.clone();
-        d.geometry.leg_length_m *= s;
-        d.geometry.body_length_m *= s;
-        for a in d.geometry.foot_semi_axes_m.iter_mut() {
-            *a *= s;
-        }
-        d.mass.total_mass_kg *= mu;
-        match contact_scaling {
-            ContactScaling::Similar => {
-                d.contact.hydroelastic_modulus_pa *= mu / (s * s);
-                d.contact.hunt_crossley_dissipation_s_per_m /= time;
-                // A time scale: ∝ the gait's √(L/g) (walker-models.json's rule).
-                d.contact.relaxation_time_s *= time;
-            }
-            ContactScaling::FixedMaterial => {}
-        }
-        // Numerical regularisation, not a material property: keep it a fixed fraction of √(gL).
-        d.contact.stiction_speed_mps *= time;
-        match &mut d.control {
-            ControlSpec::ServoSine {
-                frequency_hz,
-                torque_limit_nm,
-                ..
-            } => {
-                *frequency_hz /= time;
-                *torque_limit_nm *= mu * s;
-            }
-            ControlSpec::BangBang {
-                torque_nm,
-                frequency_hz,
-            } => {
-                *frequency_hz /= time;
-                *torque_nm *= mu * s;
-            }
-        }
-        d.numerics.time_step_s *= time;
-        for e in d.effects.iter_mut() {
-            *e = e.scaled(s, mu, contact_scaling);
-        }
-        Ok(d)
     }
 
     /// The rigid-body model, with the contact effects of `effects` applied to its contact

@@ -21,17 +21,18 @@
 //! hardstops, servo gains, effect dampings) so the stiff terms stay stable at a time step
 //! set by the gait, not by the contact.
 
-use nalgebra::{Matrix3, SMatrix, SVector, UnitQuaternion, Vector3};
+use nalgebra::{Matrix3, SMatrix, UnitQuaternion, Vector3};
 use serde::Serialize;
 
 use super::contact::{self, ContactParams, Cut, Patch};
 use super::control::Controller;
 use super::effects::{Effect, EffectContext, GeneralizedForce};
+use super::state::{Kinematics, Matrix7, State, Vector7};
 
-/// 7-vector of generalized velocities / forces (v, ω, q̇).
-pub type Vector7 = SVector<f64, 7>;
-/// 7×7 matrix (mass, damping).
-pub type Matrix7 = SMatrix<f64, 7, 7>;
+/// Standard gravity [m/s²]. A constant of the model (a slope tilts it, see
+/// [`Model::gravity_mps2`]); the similarity rules (`similarity.rs`) keep it fixed.
+pub const GRAVITY_MPS2: f64 = 9.81;
+
 type Jac = SMatrix<f64, 3, 7>;
 
 /// One rigid leg (frame origin at the hip point).
@@ -77,46 +78,6 @@ pub struct Model {
     pub gravity_mps2: Vector3<f64>,
     /// Contact with the ground (off for free-flight tests).
     pub ground_contact: bool,
-}
-
-/// Generalized state.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct State {
-    /// Hip point, world [m].
-    pub hip_position_m: Vector3<f64>,
-    /// Orientation of the left leg (leg → world).
-    pub orientation: UnitQuaternion<f64>,
-    /// Hip angle q [rad].
-    pub hip_angle_rad: f64,
-    /// Hip point velocity, world [m/s].
-    pub hip_velocity_mps: Vector3<f64>,
-    /// Left-leg angular velocity in the left-leg frame [rad/s].
-    pub angular_velocity_rad_s: Vector3<f64>,
-    /// Hip rate q̇ [rad/s].
-    pub hip_rate_rad_s: f64,
-}
-
-impl State {
-    /// Generalized velocity vector ν.
-    pub fn velocity(&self) -> Vector7 {
-        let v = self.hip_velocity_mps;
-        let w = self.angular_velocity_rad_s;
-        Vector7::from_column_slice(&[v.x, v.y, v.z, w.x, w.y, w.z, self.hip_rate_rad_s])
-    }
-
-    fn set_velocity(&mut self, nu: &Vector7) {
-        self.hip_velocity_mps = Vector3::new(nu[0], nu[1], nu[2]);
-        self.angular_velocity_rad_s = Vector3::new(nu[3], nu[4], nu[5]);
-        self.hip_rate_rad_s = nu[6];
-    }
-
-    /// True when every component is finite.
-    pub fn is_finite(&self) -> bool {
-        self.velocity().iter().all(|x| x.is_finite())
-            && self.hip_position_m.iter().all(|x| x.is_finite())
-            && self.orientation.coords.iter().all(|x| x.is_finite())
-            && self.hip_angle_rad.is_finite()
-    }
 }
 
 fn skew(v: &Vector3<f64>) -> Matrix3<f64> {
@@ -181,19 +142,6 @@ fn cholesky_solve(a: &Matrix7, b: &Vector7) -> Option<Vector7> {
 fn rot_y(q: f64) -> Matrix3<f64> {
     let (s, c) = q.sin_cos();
     Matrix3::new(c, 0.0, s, 0.0, 1.0, 0.0, -s, 0.0, c)
-}
-
-/// Kinematic quantities of one configuration.
-#[derive(Clone, Copy, Debug)]
-pub struct Kinematics {
-    /// Leg rotations (leg → world), [left, right].
-    pub rot: [Matrix3<f64>; 2],
-    /// Hip axis in world.
-    pub axis_w: Vector3<f64>,
-    /// World angular velocities of the legs.
-    pub omega_w: [Vector3<f64>; 2],
-    /// Centre-of-mass positions relative to the hip point, world.
-    pub com_offset_w: [Vector3<f64>; 2],
 }
 
 /// Breakdown of the mechanical energy [J].
@@ -415,8 +363,7 @@ impl Model {
     /// Static sinkage of one spherical foot carrying the whole weight, √(m g/(π E))
     /// (F = π E δ² for δ ≪ R): how far a start is lowered below just touching.
     pub fn single_foot_sinkage_m(&self) -> f64 {
-        (self.total_mass_kg() * super::design::GRAVITY_MPS2
-            / (std::f64::consts::PI * self.contact.modulus_pa))
+        (self.total_mass_kg() * GRAVITY_MPS2 / (std::f64::consts::PI * self.contact.modulus_pa))
             .sqrt()
     }
 

@@ -9,8 +9,7 @@ use std::path::Path;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
-use super::error::SimError;
-use super::walk::TrajectorySample;
+use crate::sim::{SimError, TrajectorySample};
 
 fn nice_ticks(lo: f64, hi: f64, n: usize) -> Vec<f64> {
     let span = (hi - lo).max(1e-12);
