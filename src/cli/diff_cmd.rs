@@ -7,8 +7,7 @@ use clap::Args;
 use robot_survey::dataset::Dataset;
 use robot_survey::report::{self, Format};
 
-use super::fit_cmd::{MethodArg, parse_confidence};
-use super::{EXIT_PROBLEMS, print};
+use super::common::{EXIT_PROBLEMS, MethodArg, parse_confidence, print};
 
 #[derive(Args, Debug)]
 #[command(

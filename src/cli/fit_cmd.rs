@@ -4,35 +4,12 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 
 use anyhow::Context;
-use clap::{Args, ValueEnum};
+use clap::Args;
 use robot_survey::analysis::table2::{self, Group};
 use robot_survey::dataset::Dataset;
-use robot_survey::regression::Method;
 use robot_survey::report::{self, Format};
 
-use super::{DatasetArgs, print};
-
-/// Line-fitting method (log–log space).
-#[derive(ValueEnum, Debug, Clone, Copy, Default, PartialEq, Eq)]
-pub enum MethodArg {
-    /// Ordinary least squares of log y on log x (the paper's method; use it to predict y).
-    #[default]
-    Ols,
-    /// Major axis: minimises perpendicular distances (symmetric in x and y).
-    Ma,
-    /// Standardised major axis (reduced major axis): the usual allometric line.
-    Sma,
-}
-
-impl From<MethodArg> for Method {
-    fn from(m: MethodArg) -> Self {
-        match m {
-            MethodArg::Ols => Method::Ols,
-            MethodArg::Ma => Method::Ma,
-            MethodArg::Sma => Method::Sma,
-        }
-    }
-}
+use super::common::{DatasetArgs, MethodArg, parse_confidence, print};
 
 #[derive(Args, Debug)]
 pub struct FitArgs {
@@ -62,15 +39,6 @@ pub struct FitArgs {
     /// List the robots of CLASS that move each exponent most (leave-one-out change in b).
     #[arg(long, value_name = "CLASS")]
     pub explain: Option<String>,
-}
-
-pub fn parse_confidence(s: &str) -> Result<f64, String> {
-    let c: f64 = s.parse().map_err(|_| format!("`{s}` is not a number"))?;
-    if c > 0.0 && c < 1.0 {
-        Ok(c)
-    } else {
-        Err(format!("confidence must be in (0, 1), got {c}"))
-    }
 }
 
 pub fn parse_group(s: &str) -> anyhow::Result<Group> {

@@ -8,7 +8,7 @@ use robot_survey::gap::{self, DiagnoseOptions, EffectLibrary, TrialSet};
 use robot_survey::report;
 use robot_survey::sim::Design;
 
-use super::print;
+use super::common::print;
 
 #[derive(Args, Debug)]
 pub struct GapArgs {

@@ -7,7 +7,7 @@ use clap::{Args, Subcommand, ValueEnum};
 use robot_survey::report;
 use robot_survey::sim::{self, ContactScaling, Design, MassLaw, WalkOptions};
 
-use super::print;
+use super::common::{SimFormat, print};
 
 /// Largest number of sizes in one `sim scale` sweep (each is a full walk).
 const MAX_SWEEP_SIZES: usize = 1000;
@@ -171,14 +171,6 @@ pub struct ScaleArgs {
     /// Draw velocity and peak torque against leg length (SVG or PNG).
     #[arg(long, value_name = "FILE")]
     pub plot: Option<PathBuf>,
-}
-
-#[derive(ValueEnum, Debug, Clone, Copy, Default, PartialEq, Eq)]
-pub enum SimFormat {
-    /// Human-readable summary.
-    #[default]
-    Text,
-    Json,
 }
 
 #[derive(Args, Debug)]
