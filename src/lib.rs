@@ -13,12 +13,14 @@
 //! - [`motors`]: the motor catalogue (scaling laws, actuator datasheets, anchors) and its validation.
 //! - [`checkpoint`]: points files of long runs: resume after an interruption, shards, merge.
 //! - [`report`]: output formats (md, tex, csv, json) and figures.
+//! - [`io`]: writing files atomically.
 
 pub mod analysis;
 pub mod checkpoint;
 pub mod crosscheck;
 pub mod dataset;
 pub mod gap;
+pub mod io;
 pub mod motors;
 pub mod regression;
 pub mod report;

@@ -11,6 +11,7 @@
 
 use std::fmt::Write as _;
 
+use super::ticks::{log_label, log_ticks_major_minor};
 use crate::analysis::table2::{Group, PowerLawRow, TABLE2_PAIRS, Table2, Var, log_points};
 use crate::dataset::{RobotClass, SurveyRow, SurveyTable};
 use crate::regression::{self, Method};
@@ -234,32 +235,8 @@ impl Axis {
     fn px(&self, v: f64) -> f64 {
         self.p0 + (v.log10() - self.lo) / (self.hi - self.lo) * (self.p1 - self.p0)
     }
-    /// (value, major) ticks: every decade, with 2 and 5 labelled when the axis spans
-    /// fewer than three decades; minor ticks at the other multiples.
     fn ticks(&self) -> Vec<(f64, bool)> {
-        let span = self.hi - self.lo;
-        let mut out = Vec::new();
-        for e in (self.lo.floor() as i32)..=(self.hi.ceil() as i32) {
-            for m in 1..10 {
-                let v = f64::from(m) * 10f64.powi(e);
-                let lv = v.log10();
-                if lv < self.lo || lv > self.hi {
-                    continue;
-                }
-                let major = m == 1 || (span < 3.0 && (m == 2 || m == 5));
-                out.push((v, major));
-            }
-        }
-        out
-    }
-}
-
-fn tick_label(v: f64) -> String {
-    let s = super::sig(v);
-    if s.contains('.') {
-        s.trim_end_matches('0').trim_end_matches('.').to_string()
-    } else {
-        s
+        log_ticks_major_minor(self.lo, self.hi)
     }
 }
 
@@ -331,7 +308,7 @@ fn panel_svg(out: &mut String, index: usize, p: &FigurePanel, confidence: f64) {
                 out,
                 "<text x=\"{x:.2}\" y=\"{:.2}\" class=\"tick\" text-anchor=\"middle\">{}</text>",
                 H - BOTTOM + 16.0,
-                tick_label(v)
+                log_label(v)
             );
         }
     }
@@ -349,7 +326,7 @@ fn panel_svg(out: &mut String, index: usize, p: &FigurePanel, confidence: f64) {
                 "<text x=\"{:.2}\" y=\"{:.2}\" class=\"tick\" text-anchor=\"end\">{}</text>",
                 LEFT - 6.0,
                 y + 4.0,
-                tick_label(v)
+                log_label(v)
             );
         }
     }

@@ -8,6 +8,7 @@ pub mod html;
 pub mod plot;
 pub mod separation;
 pub mod study;
+mod ticks;
 pub mod walk_plot;
 
 pub use diff::diff_md;
