@@ -90,7 +90,8 @@ pub fn fit(a: &FitArgs) -> anyhow::Result<ExitCode> {
             written.push(path);
         }
         let path = dir.join("survey.html");
-        let page = report::html::survey_html(&report::html::survey_figure(&table, &t2));
+        let page =
+            report::html::survey_html(&robot_survey::analysis::figure::survey_figure(&table, &t2));
         robot_survey::dataset::canonical::write_atomic(&path, page.as_bytes())?;
         written.push(path);
         eprintln!(
