@@ -171,7 +171,10 @@ fn torque_need(
         anyhow::bail!("--torque-margin must be > 0, got {}", a.torque_margin);
     }
     let points = robot_survey::study::table3::points(a.table3.as_deref())?;
-    let motors = robot_survey::motors::MotorCatalogue::locate(None).ok();
+    // A ./dataset/motors that does not load is an error (as for torque-check), not a
+    // prediction silently without the motor comparison; without that folder the bundled
+    // catalogue is used.
+    let motors = robot_survey::motors::MotorCatalogue::locate(None)?;
     let masses = pred.reference_masses();
     Ok(Some(robot_survey::study::torque_need::torque_need(
         &points,
@@ -180,7 +183,7 @@ fn torque_need(
         a.torque_contact,
         l,
         &masses,
-        motors.as_ref(),
+        Some(&motors),
         a.torque_margin,
     )?))
 }
