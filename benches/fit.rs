@@ -16,9 +16,9 @@ use std::time::Duration;
 use criterion::{Criterion, criterion_group, criterion_main};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
+use robot_survey::analysis::table2;
 use robot_survey::dataset::{RobotClass, SurveyRow, SurveyTable};
 use robot_survey::regression::{Method, fit_power_law};
-use robot_survey::survey;
 
 const N: usize = 1_000_000;
 
@@ -105,7 +105,7 @@ fn bench(c: &mut Criterion) {
     g.bench_function("table2_1m", |b| {
         b.iter(|| {
             black_box(
-                survey::table2(&table, Method::Ols, 0.95)
+                table2::table2(&table, Method::Ols, 0.95)
                     .expect("table2")
                     .fits
                     .len(),

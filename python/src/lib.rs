@@ -16,6 +16,7 @@ use pyo3::exceptions::{PyTypeError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::{PyBytes, PyDict, PyString};
 
+use robot_survey::analysis::table2::{self, Group};
 use robot_survey::dataset::{Dataset, SurveyTable};
 use robot_survey::gap::{self, DiagnoseOptions, EffectLibrary, TrialSet};
 use robot_survey::regression::Method;
@@ -23,7 +24,6 @@ use robot_survey::report;
 use robot_survey::sim::{self, ContactScaling, Design, MassLaw, WalkOptions};
 use robot_survey::study::table3::{self, Table3Point};
 use robot_survey::study::{Shard, Table3Spec};
-use robot_survey::survey::{self, Group};
 
 create_exception!(
     robot_survey,
@@ -154,7 +154,7 @@ fn fit_json(
             seed,
             level,
         });
-        let t2 = survey::table2_with_bootstrap(&table, m, level, bs)?;
+        let t2 = table2::table2_with_bootstrap(&table, m, level, bs)?;
         Ok(report::json(&t2)?)
     })
 }
@@ -177,7 +177,7 @@ fn predict_json(
     torque_margin: f64,
     table3_points: Option<PathBuf>,
 ) -> PyResult<String> {
-    use robot_survey::predict as p;
+    use robot_survey::analysis::prediction as p;
     let class = group(cls)?;
     let level = confidence(confidence_level)?;
     let torque_contact = contact(torque_contact)?;
@@ -228,14 +228,14 @@ fn predict_json(
 #[derive(serde::Serialize)]
 struct PredictionWithTorque<'a> {
     #[serde(flatten)]
-    prediction: &'a robot_survey::predict::Prediction,
+    prediction: &'a robot_survey::analysis::prediction::Prediction,
     torque: &'a robot_survey::study::torque_need::TorqueNeed,
 }
 
 /// As the CLI's `torque_need`: Table III's minimum torque at the fit's and the scaled
 /// reference's masses, and the catalogue's actuators that deliver it with the margin.
 fn torque_need(
-    pred: &robot_survey::predict::Prediction,
+    pred: &robot_survey::analysis::prediction::Prediction,
     design: &str,
     leg_length_m: f64,
     torque_contact: ContactScaling,

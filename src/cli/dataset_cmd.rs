@@ -9,7 +9,7 @@ use robot_survey::dataset::{self, Dataset, upstream};
 use robot_survey::motors::{MotorCatalogue, MotorProblem};
 use robot_survey::report;
 
-use super::{DatasetArgs, EXIT_PROBLEMS, print};
+use super::common::{DatasetArgs, EXIT_PROBLEMS, print};
 
 #[derive(ValueEnum, Debug, Clone, Copy, Default, PartialEq, Eq)]
 pub enum TextOrJson {

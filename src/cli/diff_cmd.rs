@@ -7,8 +7,7 @@ use clap::Args;
 use robot_survey::dataset::Dataset;
 use robot_survey::report::{self, Format};
 
-use super::fit_cmd::{MethodArg, parse_confidence};
-use super::{EXIT_PROBLEMS, print};
+use super::common::{EXIT_PROBLEMS, MethodArg, parse_confidence, print};
 
 #[derive(Args, Debug)]
 #[command(
@@ -36,7 +35,12 @@ pub struct DiffArgs {
 
 pub fn diff(a: &DiffArgs) -> anyhow::Result<ExitCode> {
     let ds = Dataset::locate(a.dataset.as_deref())?;
-    let d = robot_survey::diff::diff(&ds, a.against.as_deref(), a.method.into(), a.confidence)?;
+    let d = robot_survey::analysis::release_diff::diff(
+        &ds,
+        a.against.as_deref(),
+        a.method.into(),
+        a.confidence,
+    )?;
     print(&match a.format {
         Format::Json => report::json(&d)?,
         Format::Md => report::diff_md(&d),

@@ -4,35 +4,12 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 
 use anyhow::Context;
-use clap::{Args, ValueEnum};
+use clap::Args;
+use robot_survey::analysis::table2::{self, Group};
 use robot_survey::dataset::Dataset;
-use robot_survey::regression::Method;
 use robot_survey::report::{self, Format};
-use robot_survey::survey::{self, Group};
 
-use super::{DatasetArgs, print};
-
-/// Line-fitting method (log–log space).
-#[derive(ValueEnum, Debug, Clone, Copy, Default, PartialEq, Eq)]
-pub enum MethodArg {
-    /// Ordinary least squares of log y on log x (the paper's method; use it to predict y).
-    #[default]
-    Ols,
-    /// Major axis: minimises perpendicular distances (symmetric in x and y).
-    Ma,
-    /// Standardised major axis (reduced major axis): the usual allometric line.
-    Sma,
-}
-
-impl From<MethodArg> for Method {
-    fn from(m: MethodArg) -> Self {
-        match m {
-            MethodArg::Ols => Method::Ols,
-            MethodArg::Ma => Method::Ma,
-            MethodArg::Sma => Method::Sma,
-        }
-    }
-}
+use super::common::{DatasetArgs, MethodArg, parse_confidence, print};
 
 #[derive(Args, Debug)]
 pub struct FitArgs {
@@ -64,15 +41,6 @@ pub struct FitArgs {
     pub explain: Option<String>,
 }
 
-pub fn parse_confidence(s: &str) -> Result<f64, String> {
-    let c: f64 = s.parse().map_err(|_| format!("`{s}` is not a number"))?;
-    if c > 0.0 && c < 1.0 {
-        Ok(c)
-    } else {
-        Err(format!("confidence must be in (0, 1), got {c}"))
-    }
-}
-
 pub fn parse_group(s: &str) -> anyhow::Result<Group> {
     Group::parse(s).with_context(|| {
         format!("unknown class `{s}` (one of: lower-biped, full-biped, quadruped, hexapod, all)")
@@ -84,7 +52,7 @@ pub fn fit(a: &FitArgs) -> anyhow::Result<ExitCode> {
     let table = ds.table(a.data.release.as_deref())?;
     if let Some(class) = &a.explain {
         let g = parse_group(class)?;
-        let ex = survey::explain(&table, g, a.method.into())?;
+        let ex = table2::explain(&table, g, a.method.into())?;
         print(&match a.format {
             Format::Json => report::json(&ex)?,
             _ => report::explain_text(&ex),
@@ -98,7 +66,7 @@ pub fn fit(a: &FitArgs) -> anyhow::Result<ExitCode> {
             seed: a.seed,
             level: a.confidence,
         });
-    let t2 = survey::table2_with_bootstrap(&table, a.method.into(), a.confidence, bootstrap)?;
+    let t2 = table2::table2_with_bootstrap(&table, a.method.into(), a.confidence, bootstrap)?;
     if let Some(dir) = &a.out {
         std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
         let mut written = Vec::new();
@@ -122,7 +90,8 @@ pub fn fit(a: &FitArgs) -> anyhow::Result<ExitCode> {
             written.push(path);
         }
         let path = dir.join("survey.html");
-        let page = report::html::survey_html(&report::html::survey_figure(&table, &t2));
+        let page =
+            report::html::survey_html(&robot_survey::analysis::figure::survey_figure(&table, &t2));
         robot_survey::dataset::canonical::write_atomic(&path, page.as_bytes())?;
         written.push(path);
         eprintln!(
@@ -186,14 +155,14 @@ pub struct PredictArgs {
 #[derive(serde::Serialize)]
 struct PredictionWithTorque<'a> {
     #[serde(flatten)]
-    prediction: &'a robot_survey::predict::Prediction,
+    prediction: &'a robot_survey::analysis::prediction::Prediction,
     torque: &'a robot_survey::study::torque_need::TorqueNeed,
 }
 
 fn torque_need(
     a: &PredictArgs,
     design: &str,
-    pred: &robot_survey::predict::Prediction,
+    pred: &robot_survey::analysis::prediction::Prediction,
 ) -> anyhow::Result<Option<robot_survey::study::torque_need::TorqueNeed>> {
     let Some(l) = a.leg_length else {
         return Ok(None);
@@ -202,7 +171,10 @@ fn torque_need(
         anyhow::bail!("--torque-margin must be > 0, got {}", a.torque_margin);
     }
     let points = robot_survey::study::table3::points(a.table3.as_deref())?;
-    let motors = robot_survey::motors::MotorCatalogue::locate(None).ok();
+    // A ./dataset/motors that does not load is an error (as for torque-check), not a
+    // prediction silently without the motor comparison; without that folder the bundled
+    // catalogue is used.
+    let motors = robot_survey::motors::MotorCatalogue::locate(None)?;
     let masses = pred.reference_masses();
     Ok(Some(robot_survey::study::torque_need::torque_need(
         &points,
@@ -211,13 +183,13 @@ fn torque_need(
         a.torque_contact,
         l,
         &masses,
-        motors.as_ref(),
+        Some(&motors),
         a.torque_margin,
     )?))
 }
 
 pub fn predict(a: &PredictArgs) -> anyhow::Result<ExitCode> {
-    use robot_survey::predict as p;
+    use robot_survey::analysis::prediction as p;
     let ds = Dataset::locate(a.data.dataset.as_deref())?;
     let table = ds.table(a.data.release.as_deref())?;
     let class = parse_group(&a.class)?;
@@ -316,13 +288,13 @@ pub enum TestCommand {
     },
 }
 
-fn parse_var(s: &str) -> anyhow::Result<survey::Var> {
-    survey::Var::parse(s)
+fn parse_var(s: &str) -> anyhow::Result<table2::Var> {
+    table2::Var::parse(s)
         .with_context(|| format!("unknown variable `{s}` (one of: leg_length, body_length, mass)"))
 }
 
 pub fn test(a: &TestArgs) -> anyhow::Result<ExitCode> {
-    use robot_survey::inference;
+    use robot_survey::analysis::inference;
     let common = match &a.test {
         TestCommand::Slope { common, .. } | TestCommand::CommonSlope { common, .. } => common,
     };
@@ -383,7 +355,7 @@ pub struct LawsArgs {
 pub fn laws(a: &LawsArgs) -> anyhow::Result<ExitCode> {
     let ds = Dataset::locate(a.data.dataset.as_deref())?;
     let table = ds.table(a.data.release.as_deref())?;
-    let t = robot_survey::laws::law_table(&ds, &table, a.confidence)?;
+    let t = robot_survey::analysis::laws::law_table(&ds, &table, a.confidence)?;
     print(&match a.format {
         Format::Json => report::json(&t)?,
         _ => report::laws_md(&t),

@@ -5,10 +5,11 @@ use std::process::ExitCode;
 
 use clap::{Args, Subcommand, ValueEnum};
 use robot_survey::gap::{self, DiagnoseOptions, EffectLibrary, TrialSet};
+use robot_survey::io::write_atomic;
 use robot_survey::report;
 use robot_survey::sim::Design;
 
-use super::print;
+use super::common::print;
 
 #[derive(Args, Debug)]
 pub struct GapArgs {
@@ -569,21 +570,6 @@ fn waveform_benchmark(a: &WaveformBenchArgs) -> anyhow::Result<ExitCode> {
     )?;
     eprintln!("wrote {} ({} walks, {elapsed:.0} s)", md.display(), b.walks);
     Ok(ExitCode::SUCCESS)
-}
-
-/// Writes through a temporary file in the same folder, so a failure leaves no half file.
-pub fn write_atomic(path: &std::path::Path, bytes: &[u8]) -> anyhow::Result<()> {
-    let dir = path
-        .parent()
-        .filter(|p| !p.as_os_str().is_empty())
-        .unwrap_or(std::path::Path::new("."));
-    let tmp = dir.join(format!(
-        ".{}.tmp",
-        path.file_name().and_then(|f| f.to_str()).unwrap_or("out")
-    ));
-    std::fs::write(&tmp, bytes).map_err(|e| anyhow::anyhow!("{}: {e}", tmp.display()))?;
-    std::fs::rename(&tmp, path).map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
-    Ok(())
 }
 
 fn diagnose(a: &DiagnoseArgs) -> anyhow::Result<ExitCode> {

@@ -1,6 +1,7 @@
 //! Command-line parsing and dispatch. Exit codes follow ripgrep: 0 success, 1 problems
 //! found (validation errors, a check that failed), 2 could not run (bad input, I/O).
 
+mod common;
 mod dataset_cmd;
 mod diff_cmd;
 mod fit_cmd;
@@ -8,15 +9,11 @@ mod gap;
 mod sim;
 mod study;
 
-use std::path::PathBuf;
 use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
 
-/// Exit code: the command ran and found problems.
-pub const EXIT_PROBLEMS: u8 = 1;
-/// Exit code: the command could not run.
-pub const EXIT_ERROR: u8 = 2;
+use common::EXIT_ERROR;
 
 #[derive(Parser, Debug)]
 #[command(
@@ -33,17 +30,6 @@ pub const EXIT_ERROR: u8 = 2;
 pub struct Cli {
     #[command(subcommand)]
     pub command: Command,
-}
-
-/// Options shared by every command that reads the dataset.
-#[derive(clap::Args, Debug, Clone, Default)]
-pub struct DatasetArgs {
-    /// Dataset directory (default: ./dataset when present, else the bundled copy).
-    #[arg(long, value_name = "DIR")]
-    pub dataset: Option<PathBuf>,
-    /// Use a frozen release (e.g. 1.0.0, the table as the paper used it) instead of the live records.
-    #[arg(long, value_name = "X.Y.Z")]
-    pub release: Option<String>,
 }
 
 #[derive(Subcommand, Debug)]
@@ -105,15 +91,5 @@ fn run(cli: Cli) -> anyhow::Result<ExitCode> {
         Command::Sim(a) => sim::run(&a),
         Command::Gap(a) => gap::run(&a),
         Command::TorqueCheck(a) => study::torque_check(&a),
-    }
-}
-
-/// Writes `text` to stdout, ignoring a closed pipe (`survey fit | head`).
-pub fn print(text: &str) {
-    use std::io::Write;
-    let mut out = std::io::stdout().lock();
-    let _ = out.write_all(text.as_bytes());
-    if !text.ends_with('\n') {
-        let _ = out.write_all(b"\n");
     }
 }

@@ -7,7 +7,7 @@ use clap::{Args, Subcommand, ValueEnum};
 use robot_survey::report;
 use robot_survey::sim::{self, ContactScaling, Design, MassLaw, WalkOptions};
 
-use super::print;
+use super::common::{SimFormat, print};
 
 /// Largest number of sizes in one `sim scale` sweep (each is a full walk).
 const MAX_SWEEP_SIZES: usize = 1000;
@@ -173,14 +173,6 @@ pub struct ScaleArgs {
     pub plot: Option<PathBuf>,
 }
 
-#[derive(ValueEnum, Debug, Clone, Copy, Default, PartialEq, Eq)]
-pub enum SimFormat {
-    /// Human-readable summary.
-    #[default]
-    Text,
-    Json,
-}
-
 #[derive(Args, Debug)]
 #[command(
     after_help = "Examples:\n  survey sim walk --design mugatu\n  survey sim walk --design zippy --leg-length 0.5 --mass-law l3 --format json\n  survey sim walk --design my-walker.toml --trajectory walk.csv --plot walk.svg\n\n\
@@ -293,7 +285,9 @@ fn scale(a: &ScaleArgs) -> anyhow::Result<ExitCode> {
     );
     bar.set_message(format!("simulating {}", a.run.design));
     let study =
-        robot_survey::scaling::scaling_study(&design, &a.leg_lengths, &base, &|| bar.inc(1))?;
+        robot_survey::study::scaling::scaling_study(&design, &a.leg_lengths, &base, &|| {
+            bar.inc(1)
+        })?;
     bar.finish_and_clear();
     if let Some(path) = &a.plot {
         report::plot::draw_panels(path, &report::plot::scaling_panels(&study), (1200, 520))?;
@@ -326,7 +320,7 @@ fn walk(a: &WalkArgs) -> anyhow::Result<ExitCode> {
             "{} at L = {:.3} m ({:?})",
             r.design, r.leg_length_m, r.mass_law
         );
-        sim::write_plot_svg(&result.trajectory, &title, path)?;
+        robot_survey::report::walk_plot::write_plot_svg(&result.trajectory, &title, path)?;
         eprintln!("wrote {}", path.display());
     }
     print(&match a.run.format {

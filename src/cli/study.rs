@@ -11,7 +11,7 @@ use robot_survey::study::sweep::{self, Shard};
 use robot_survey::study::table3::{self, TABLE3_KIND, Table3Point};
 use robot_survey::study::{Table3Spec, run_table3};
 
-use super::print;
+use super::common::{SimFormat, print};
 
 /// Which contact rules a study runs.
 #[derive(ValueEnum, Debug, Clone, Copy, Default, PartialEq, Eq)]
@@ -441,8 +441,8 @@ pub struct TorqueCheckArgs {
     /// Motor catalogue folder (default: dataset/motors when present, else the bundled one).
     #[arg(long, value_name = "DIR")]
     pub motors: Option<PathBuf>,
-    #[arg(long, value_enum, default_value_t = super::sim::SimFormat::Text)]
-    pub format: super::sim::SimFormat,
+    #[arg(long, value_enum, default_value_t = SimFormat::Text)]
+    pub format: SimFormat,
 }
 
 /// Table III points: a file, or the bundled copy.
@@ -482,8 +482,8 @@ pub fn torque_check(a: &TorqueCheckArgs) -> anyhow::Result<ExitCode> {
         eprintln!("wrote {}", path.display());
     }
     print(&match a.format {
-        super::sim::SimFormat::Json => report::json(&check)?,
-        super::sim::SimFormat::Text => report::study::torque_check_text(&check),
+        SimFormat::Json => report::json(&check)?,
+        SimFormat::Text => report::study::torque_check_text(&check),
     });
     Ok(ExitCode::SUCCESS)
 }

@@ -184,13 +184,10 @@ pub fn fmt(ds: &Dataset, check: bool) -> Result<FmtReport, DatasetError> {
     Ok(report)
 }
 
-/// Writes through a sibling temporary file and a rename, so a crash never leaves half a file.
+/// [`crate::io::write_atomic`], its errors naming `path` (as the dataset commands report).
 pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), DatasetError> {
-    let io = |e| DatasetError::Io {
+    crate::io::write_atomic(path, bytes).map_err(|e| DatasetError::Io {
         path: path.display().to_string(),
-        source: e,
-    };
-    let tmp = path.with_extension("tmp~");
-    std::fs::write(&tmp, bytes).map_err(io)?;
-    std::fs::rename(&tmp, path).map_err(io)
+        source: e.error,
+    })
 }

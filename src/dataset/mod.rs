@@ -18,6 +18,7 @@ pub mod datapackage;
 pub mod problem;
 pub mod record;
 pub mod release;
+pub mod selection;
 pub mod upstream;
 pub mod validate;
 pub mod vocabulary;

@@ -12,9 +12,11 @@ use serde::Serialize;
 
 use super::Dataset;
 use super::problem::{Problem, Rule, Severity};
-use super::record::{Robot, RobotClass, SourceKind, Value};
-use super::release::{self, parse_semver};
-use super::vocabulary::FieldType;
+use super::record::{Datum, Robot, RobotClass, SourceKind, Value};
+use super::release::{self, SurveyTable, parse_semver};
+use super::selection::{Group, TABLE2_PAIRS, log_points};
+use super::vocabulary::{FieldSpec, FieldType};
+use crate::regression::studentized_outliers;
 
 /// Standard gravity [m/s²], for Froude numbers.
 pub const G_MPS2: f64 = 9.80665;
@@ -125,6 +127,22 @@ fn problem(
         .line(text.and_then(|t| super::record::line_of_key(t, key)))
 }
 
+/// Where a record's problems go, with its file, the record and its text (for the line of
+/// each field).
+struct RecordCheck<'a> {
+    file: &'a str,
+    r: &'a Robot,
+    text: Option<&'a str>,
+    problems: &'a mut Vec<Problem>,
+}
+
+impl RecordCheck<'_> {
+    fn push(&mut self, field: &str, sev: Severity, rule: Rule, msg: String) {
+        self.problems
+            .push(problem(self.file, self.r, field, sev, rule, msg, self.text));
+    }
+}
+
 fn check_record(
     ds: &Dataset,
     rel: &str,
@@ -133,15 +151,35 @@ fn check_record(
     text: Option<&str>,
     problems: &mut Vec<Problem>,
 ) {
-    let mut push = |field: &str, sev, rule, msg: String| {
-        problems.push(problem(file, r, field, sev, rule, msg, text))
+    let mut c = RecordCheck {
+        file,
+        r,
+        text,
+        problems,
     };
-    use Severity::{Error, Warning};
+    check_id(&mut c, rel);
+    for (name, d) in &r.values {
+        let Some(spec) = ds.vocab.get(name) else {
+            continue;
+        };
+        check_value(&mut c, name, d, spec);
+        check_value_provenance(&mut c, name, d, spec);
+    }
+    check_sources(&mut c);
+    check_fit_status(&mut c, ds);
+    check_definitions(&mut c);
+    check_unit_slips(&mut c);
+    check_class(&mut c);
+    check_froude(&mut c);
+}
 
-    // File name and id.
+/// File name and id.
+fn check_id(c: &mut RecordCheck, rel: &str) {
+    use Severity::Error;
+    let r = c.r;
     let stem = rel.trim_start_matches("robots/").trim_end_matches(".toml");
     if stem != r.id {
-        push(
+        c.push(
             "id",
             Error,
             Rule::FileName,
@@ -154,144 +192,153 @@ fn check_record(
             .bytes()
             .all(|b| b.is_ascii_lowercase() || b.is_ascii_digit() || b == b'-')
     {
-        push(
+        c.push(
             "id",
             Error,
             Rule::Type,
             format!("id `{}` must be lowercase letters, digits and `-`", r.id),
         );
     }
+}
 
-    // Types, ranges, allowed values.
-    for (name, d) in &r.values {
-        let Some(spec) = ds.vocab.get(name) else {
+/// Types, ranges, allowed values of one value.
+fn check_value(c: &mut RecordCheck, name: &str, d: &Datum, spec: &FieldSpec) {
+    use Severity::Error;
+    let r = c.r;
+    let field = format!("values.{name}");
+    let nums: Vec<f64> = match &d.value {
+        Value::Number(x) => vec![*x],
+        Value::Integer(i) => vec![*i as f64],
+        Value::Range { min, max } => min.iter().chain(max.iter()).copied().collect(),
+        _ => vec![],
+    };
+    for x in nums {
+        if !x.is_finite() {
+            c.push(
+                &field,
+                Error,
+                Rule::Type,
+                format!("`{name}` is not a finite number"),
+            );
             continue;
-        };
-        let field = format!("values.{name}");
-        let nums: Vec<f64> = match &d.value {
-            Value::Number(x) => vec![*x],
-            Value::Integer(i) => vec![*i as f64],
-            Value::Range { min, max } => min.iter().chain(max.iter()).copied().collect(),
-            _ => vec![],
-        };
-        for x in nums {
-            if !x.is_finite() {
-                push(
-                    &field,
-                    Error,
-                    Rule::Type,
-                    format!("`{name}` is not a finite number"),
-                );
-                continue;
-            }
-            let below = spec.min.is_some_and(|m| x < m);
-            let above = spec.max.is_some_and(|m| x > m);
-            if below || above {
-                push(
-                    &field,
-                    Error,
-                    Rule::Range,
-                    format!(
-                        "`{name}` = {x} {} is outside the plausible range [{}, {}] {}; check the unit ({})",
-                        spec.unit,
-                        spec.min.map(|m| m.to_string()).unwrap_or("-inf".into()),
-                        spec.max.map(|m| m.to_string()).unwrap_or("inf".into()),
-                        spec.unit,
-                        spec.description
-                    ),
-                );
-            }
         }
-        if let Value::Range {
-            min: Some(lo),
-            max: Some(hi),
-        } = d.value
-            && lo > hi
-        {
-            push(
-                &field,
-                Error,
-                Rule::Definition,
-                format!("range min {lo} > max {hi}"),
-            );
-        }
-        if let Value::Range { .. } = d.value
-            && spec.fit_variable
-            && r.fit
-        {
-            push(
-                &field,
-                Error,
-                Rule::Exclusion,
-                format!("`{name}` is used in fits and needs a point `value`, not a range"),
-            );
-        }
-        if spec.field_type == FieldType::Text
-            && !spec.allowed.is_empty()
-            && let Value::Text(s) = &d.value
-            && !spec.allowed.iter().any(|a| a == s)
-        {
-            push(
+        let below = spec.min.is_some_and(|m| x < m);
+        let above = spec.max.is_some_and(|m| x > m);
+        if below || above {
+            c.push(
                 &field,
                 Error,
                 Rule::Range,
-                format!("`{s}` is not one of: {}", spec.allowed.join(" | ")),
-            );
-        }
-        // Provenance of each value.
-        if d.sources.is_empty() {
-            let fitted = spec.fit_variable && r.fit;
-            push(
-                &field,
-                if fitted { Error } else { Warning },
-                Rule::Provenance,
-                if fitted {
-                    format!("`{name}` is used in a fit but names no source")
-                } else {
-                    format!("`{name}` names no source")
-                },
-            );
-        }
-        if d.derived && d.derivation.as_deref().is_none_or(|x| x.trim().is_empty()) {
-            push(
-                &field,
-                Error,
-                Rule::Provenance,
                 format!(
-                    "`{name}` is marked derived but has no `derivation` note saying how it was derived from its source"
+                    "`{name}` = {x} {} is outside the plausible range [{}, {}] {}; check the unit ({})",
+                    spec.unit,
+                    spec.min.map(|m| m.to_string()).unwrap_or("-inf".into()),
+                    spec.max.map(|m| m.to_string()).unwrap_or("inf".into()),
+                    spec.unit,
+                    spec.description
                 ),
             );
         }
-        if !d.derived && d.derivation.is_some() {
-            push(
+    }
+    if let Value::Range {
+        min: Some(lo),
+        max: Some(hi),
+    } = d.value
+        && lo > hi
+    {
+        c.push(
+            &field,
+            Error,
+            Rule::Definition,
+            format!("range min {lo} > max {hi}"),
+        );
+    }
+    if let Value::Range { .. } = d.value
+        && spec.fit_variable
+        && r.fit
+    {
+        c.push(
+            &field,
+            Error,
+            Rule::Exclusion,
+            format!("`{name}` is used in fits and needs a point `value`, not a range"),
+        );
+    }
+    if spec.field_type == FieldType::Text
+        && !spec.allowed.is_empty()
+        && let Value::Text(s) = &d.value
+        && !spec.allowed.iter().any(|a| a == s)
+    {
+        c.push(
+            &field,
+            Error,
+            Rule::Range,
+            format!("`{s}` is not one of: {}", spec.allowed.join(" | ")),
+        );
+    }
+}
+
+/// Provenance of one value.
+fn check_value_provenance(c: &mut RecordCheck, name: &str, d: &Datum, spec: &FieldSpec) {
+    use Severity::{Error, Warning};
+    let r = c.r;
+    let field = format!("values.{name}");
+    if d.sources.is_empty() {
+        let fitted = spec.fit_variable && r.fit;
+        c.push(
+            &field,
+            if fitted { Error } else { Warning },
+            Rule::Provenance,
+            if fitted {
+                format!("`{name}` is used in a fit but names no source")
+            } else {
+                format!("`{name}` names no source")
+            },
+        );
+    }
+    if d.derived && d.derivation.as_deref().is_none_or(|x| x.trim().is_empty()) {
+        c.push(
+            &field,
+            Error,
+            Rule::Provenance,
+            format!(
+                "`{name}` is marked derived but has no `derivation` note saying how it was derived from its source"
+            ),
+        );
+    }
+    if !d.derived && d.derivation.is_some() {
+        c.push(
+            &field,
+            Warning,
+            Rule::Provenance,
+            format!("`{name}` has a `derivation` note but is not marked `derived = true`"),
+        );
+    }
+    for key in d
+        .sources
+        .iter()
+        .chain(d.history.iter().flat_map(|h| h.sources.iter()))
+    {
+        if !r.sources.iter().any(|s| &s.key == key) {
+            c.push(
                 &field,
-                Warning,
+                Error,
                 Rule::Provenance,
-                format!("`{name}` has a `derivation` note but is not marked `derived = true`"),
+                format!("source `{key}` is not among the record's [[sources]]"),
             );
         }
-        for key in d
-            .sources
-            .iter()
-            .chain(d.history.iter().flat_map(|h| h.sources.iter()))
-        {
-            if !r.sources.iter().any(|s| &s.key == key) {
-                push(
-                    &field,
-                    Error,
-                    Rule::Provenance,
-                    format!("source `{key}` is not among the record's [[sources]]"),
-                );
-            }
-        }
     }
+}
 
-    // Sources themselves.
+/// Sources themselves.
+fn check_sources(c: &mut RecordCheck) {
+    use Severity::Error;
+    let r = c.r;
     let mut keys = BTreeMap::new();
     for (i, s) in r.sources.iter().enumerate() {
         let field = format!("sources[{i}]");
         if keys.insert(s.key.clone(), i).is_some() {
-            push(
+            c.push(
                 &field,
                 Error,
                 Rule::Provenance,
@@ -303,7 +350,7 @@ fn check_record(
                 if !(u.starts_with("https://") || u.starts_with("http://"))
                     || u.contains(char::is_whitespace) =>
             {
-                push(
+                c.push(
                     &format!("{field}.url"),
                     Error,
                     Rule::Provenance,
@@ -311,7 +358,7 @@ fn check_record(
                 );
             }
             (None, SourceKind::Lab) if s.title.is_some() => {}
-            (None, _) => push(
+            (None, _) => c.push(
                 &field,
                 Error,
                 Rule::Provenance,
@@ -323,10 +370,14 @@ fn check_record(
             _ => {}
         }
     }
+}
 
-    // Fit status.
+/// Fit status.
+fn check_fit_status(c: &mut RecordCheck, ds: &Dataset) {
+    use Severity::{Error, Warning};
+    let r = c.r;
     if !r.fit && r.exclusion.as_deref().is_none_or(|e| e.trim().is_empty()) {
-        push(
+        c.push(
             "exclusion",
             Error,
             Rule::Exclusion,
@@ -335,7 +386,7 @@ fn check_record(
     }
     if r.fit {
         if r.class == RobotClass::Hybrid {
-            push(
+            c.push(
                 "fit",
                 Error,
                 Rule::Class,
@@ -349,7 +400,7 @@ fn check_record(
                     Some(Value::Range { .. })
                 )
             {
-                push(
+                c.push(
                     &format!("values.{}", f.name),
                     Error,
                     Rule::Exclusion,
@@ -361,7 +412,7 @@ fn check_record(
             }
         }
         if r.exclusion.is_some() {
-            push(
+            c.push(
                 "exclusion",
                 Warning,
                 Rule::Exclusion,
@@ -369,15 +420,19 @@ fn check_record(
             );
         }
     }
+}
 
-    // Definitions.
+/// Definitions.
+fn check_definitions(c: &mut RecordCheck) {
+    use Severity::{Error, Warning};
+    let r = c.r;
     let leg = r.number("leg_length_m");
     let body = r.number("body_length_m");
     let mass = r.number("mass_kg");
     if let (Some(l), Some(b)) = (leg, body)
         && l > b
     {
-        push(
+        c.push(
             "values.leg_length_m",
             Error,
             Rule::Definition,
@@ -390,7 +445,7 @@ fn check_record(
         if let Some(lo) = r.number("mass_min_kg")
             && lo > m
         {
-            push(
+            c.push(
                 "values.mass_min_kg",
                 Error,
                 Rule::Definition,
@@ -400,7 +455,7 @@ fn check_record(
         if let Some(hi) = r.number("mass_max_kg")
             && hi < m
         {
-            push(
+            c.push(
                 "values.mass_max_kg",
                 Error,
                 Rule::Definition,
@@ -420,7 +475,7 @@ fn check_record(
         if let Some((given, absent, b)) = one
             && (m - b).abs() > 1e-9 * m.abs().max(b.abs())
         {
-            push(
+            c.push(
                 "values.mass_kg",
                 Warning,
                 Rule::Definition,
@@ -433,15 +488,22 @@ fn check_record(
     if let (Some(lo), Some(hi)) = (r.number("mass_min_kg"), r.number("mass_max_kg"))
         && lo > hi
     {
-        push(
+        c.push(
             "values.mass_min_kg",
             Error,
             Rule::Definition,
             format!("mass_min {lo} kg exceeds mass_max {hi} kg"),
         );
     }
+}
 
-    // Unit slips: mass against leg³, body against leg.
+/// Unit slips: mass against leg³, body against leg.
+fn check_unit_slips(c: &mut RecordCheck) {
+    use Severity::Error;
+    let r = c.r;
+    let leg = r.number("leg_length_m");
+    let body = r.number("body_length_m");
+    let mass = r.number("mass_kg");
     if let (Some(l), Some(m)) = (leg, mass) {
         let rho = m / l.powi(3);
         let (lo, hi) = MASS_PER_LEG_CUBED;
@@ -451,7 +513,7 @@ fn check_record(
             } else {
                 "a leg length typed in mm or cm, or a mass in tonnes?"
             };
-            push(
+            c.push(
                 "values.mass_kg",
                 Error,
                 Rule::UnitPlausibility,
@@ -464,7 +526,7 @@ fn check_record(
     if let (Some(l), Some(b)) = (leg, body)
         && b / l > 20.0
     {
-        push(
+        c.push(
             "values.body_length_m",
             Error,
             Rule::UnitPlausibility,
@@ -474,7 +536,7 @@ fn check_record(
     if let (Some(p), Some(m)) = (r.number("battery_mass_kg"), mass)
         && p >= m
     {
-        push(
+        c.push(
             "values.battery_mass_kg",
             Error,
             Rule::Consistency,
@@ -487,19 +549,23 @@ fn check_record(
         mass,
     ) && a * n as f64 > m
     {
-        push(
+        c.push(
             "values.actuator_mass_kg",
             Error,
             Rule::Consistency,
             format!("{n} actuators of {a} kg weigh more than the robot ({m} kg)"),
         );
     }
+}
 
-    // Class rules (paper, Sec. II): a biped without upper torso or with < 4 DOF is a
-    // lower biped, any other biped a full biped.
+/// Class rules (paper, Sec. II): a biped without upper torso or with < 4 DOF is a
+/// lower biped, any other biped a full biped.
+fn check_class(c: &mut RecordCheck) {
+    use Severity::{Error, Warning};
+    let r = c.r;
     if matches!(r.class, RobotClass::LowerBiped | RobotClass::FullBiped) {
         match r.bool("has_torso") {
-            None => push(
+            None => c.push(
                 "values.has_torso",
                 Error,
                 Rule::Class,
@@ -509,7 +575,7 @@ fn check_record(
                 let dof = r.integer("dof");
                 let lower = !torso || dof.is_some_and(|d| d < 4);
                 if r.class == RobotClass::FullBiped && lower {
-                    push(
+                    c.push(
                         "class",
                         Error,
                         Rule::Class,
@@ -521,7 +587,7 @@ fn check_record(
                     );
                 }
                 if r.class == RobotClass::LowerBiped && !lower {
-                    push(
+                    c.push(
                         "class",
                         Error,
                         Rule::Class,
@@ -534,15 +600,20 @@ fn check_record(
             }
         }
     } else if r.values.contains_key("has_torso") && r.class != RobotClass::Hybrid {
-        push(
+        c.push(
             "values.has_torso",
             Warning,
             Rule::Class,
             "`has_torso` only decides between biped classes".into(),
         );
     }
+}
 
-    // Consistency with locomotion physics: walking above Froude 1 is impossible.
+/// Consistency with locomotion physics: walking above Froude 1 is impossible.
+fn check_froude(c: &mut RecordCheck) {
+    use Severity::Warning;
+    let r = c.r;
+    let leg = r.number("leg_length_m");
     if let Some(l) = leg {
         for f in ["speed_walking_mps", "speed_normal_mps"] {
             if let Some(v) = r.number(f) {
@@ -553,7 +624,7 @@ fn check_record(
                 let biped = matches!(r.class, RobotClass::LowerBiped | RobotClass::FullBiped);
                 let walking = f == "speed_walking_mps" || (biped && !running);
                 if fr > WALK_FROUDE_LIMIT && walking {
-                    push(
+                    c.push(
                         &format!("values.{f}"),
                         Warning,
                         Rule::Consistency,
@@ -611,21 +682,79 @@ fn check_duplicates(ds: &Dataset, problems: &mut Vec<Problem>) {
 
 fn check_outliers(ds: &Dataset, problems: &mut Vec<Problem>) {
     let table = release::compile(ds);
-    for o in crate::survey::outliers(&table, OUTLIER_T) {
-        let Some((rel, _)) = ds.robots.iter().find(|(_, r)| r.id == o.id) else {
+    let locate = |id: &str| {
+        let (rel, _) = ds.robots.iter().find(|(_, r)| r.id == id)?;
+        Some((ds.files.display(rel), None))
+    };
+    push_outliers(
+        &table,
+        locate,
+        "; check the values and their sources",
+        problems,
+    );
+}
+
+/// A fitted robot far from its class line in one Table 2 relation.
+struct Outlier {
+    id: String,
+    class: Group,
+    x: &'static str,
+    y: &'static str,
+    y_field: &'static str,
+    /// Externally studentized (leave-one-out) residual of the OLS log–log fit.
+    t: f64,
+}
+
+/// Fitted robots whose leave-one-out studentized residual exceeds [`OUTLIER_T`] in any
+/// Table 2 relation of their class (classes with fewer than 5 robots are skipped).
+fn outliers(table: &SurveyTable) -> Vec<Outlier> {
+    let mut out = Vec::new();
+    for class in RobotClass::FITTED {
+        let g = Group::Class(class);
+        for (x, y) in TABLE2_PAIRS {
+            // Unusable values (non-positive, …) are the other rules' business.
+            let Ok(p) = log_points(table, g, x, y) else {
+                continue;
+            };
+            for (i, t) in studentized_outliers(&p.lx, &p.ly, OUTLIER_T) {
+                out.push(Outlier {
+                    id: p.ids[i].clone(),
+                    class: g,
+                    x: x.as_str(),
+                    y: y.as_str(),
+                    y_field: y.field(),
+                    t,
+                });
+            }
+        }
+    }
+    out
+}
+
+/// One warning per outlier of `table`, at the file (and line) `locate` gives its robot
+/// (none: not reported); `advice` ends the message.
+fn push_outliers(
+    table: &SurveyTable,
+    locate: impl Fn(&str) -> Option<(String, Option<usize>)>,
+    advice: &str,
+    problems: &mut Vec<Problem>,
+) {
+    for o in outliers(table) {
+        let Some((file, line)) = locate(&o.id) else {
             continue;
         };
         problems.push(
             Problem::warning(
-                &ds.files.display(rel),
+                &file,
                 Rule::Outlier,
                 format!(
-                    "{} vs {}: leave-one-out studentized residual {:+.2} against the {} fit (|t| > {OUTLIER_T}); check the values and their sources",
+                    "{} vs {}: leave-one-out studentized residual {:+.2} against the {} fit (|t| > {OUTLIER_T}){advice}",
                     o.y, o.x, o.t, o.class
                 ),
             )
             .robot(o.id.clone())
-            .field(format!("values.{}", o.y_field)),
+            .field(format!("values.{}", o.y_field))
+            .line(line),
         );
     }
 }
@@ -848,7 +977,7 @@ pub fn validate_release_rows(
     ds: &Dataset,
     version: &str,
 ) -> Result<Vec<Problem>, super::DatasetError> {
-    use super::record::{Datum, Source};
+    use super::record::Source;
     let table = release::load_release(ds, version)?;
     let rel = format!("releases/{version}/{}", release::TABLE_CSV);
     let file = ds.files.display(&rel);
@@ -915,22 +1044,11 @@ pub fn validate_release_rows(
             problems.push(p);
         }
     }
-    for o in crate::survey::outliers(&table, OUTLIER_T) {
-        let line = table.rows.iter().position(|r| r.id == o.id).map(|i| i + 2);
-        problems.push(
-            Problem::warning(
-                &file,
-                Rule::Outlier,
-                format!(
-                    "{} vs {}: leave-one-out studentized residual {:+.2} against the {} fit (|t| > {OUTLIER_T})",
-                    o.y, o.x, o.t, o.class
-                ),
-            )
-            .robot(o.id.clone())
-            .field(format!("values.{}", o.y_field))
-            .line(line),
-        );
-    }
+    let locate = |id: &str| {
+        let line = table.rows.iter().position(|r| r.id == id).map(|i| i + 2);
+        Some((file.clone(), line))
+    };
+    push_outliers(&table, locate, "", &mut problems);
     problems.sort_by(|a, b| {
         (a.severity, a.line, &a.field, a.rule).cmp(&(b.severity, b.line, &b.field, b.rule))
     });

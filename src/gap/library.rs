@@ -165,17 +165,21 @@ fn design_value(effect: &str, param: &str, d: &Design) -> f64 {
     }
 }
 
+/// `dataset/effects/` compiled into the binary. Embedded here (as `study::paper` embeds its
+/// table) rather than taken from `dataset`'s copy, so that gap depends on sim and
+/// regression only; the files are a few kB.
+static BUNDLED_EFFECTS: include_dir::Dir<'_> =
+    include_dir::include_dir!("$CARGO_MANIFEST_DIR/dataset/effects");
+
 impl EffectLibrary {
     /// The bundled library (dataset/effects/ as compiled in).
     pub fn bundled() -> Result<EffectLibrary, GapError> {
-        let dir = crate::dataset::bundled_dir("effects")
-            .ok_or_else(|| GapError::Library("dataset/effects is not bundled".into()))?;
-        let mut files: Vec<(String, String)> = dir
+        let mut files: Vec<(String, String)> = BUNDLED_EFFECTS
             .files()
             .filter(|f| f.path().extension().is_some_and(|e| e == "toml"))
             .map(|f| {
                 (
-                    format!("dataset/{} (bundled)", f.path().display()),
+                    format!("dataset/effects/{} (bundled)", f.path().display()),
                     f.contents_utf8().unwrap_or("").to_string(),
                 )
             })

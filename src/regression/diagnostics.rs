@@ -75,6 +75,25 @@ pub fn ols_diagnostics(x: &[f64], y: &[f64]) -> Result<OlsDiagnostics, Regressio
     })
 }
 
+/// The leave-one-out outlier rule: the points whose externally studentized residual in
+/// the OLS fit of `y` on `x` exceeds `threshold` in magnitude, as (index, residual) in
+/// input order. Fewer than 5 points, or data that admit no fit, give none: too few to call
+/// one point unusual.
+pub fn studentized_outliers(x: &[f64], y: &[f64], threshold: f64) -> Vec<(usize, f64)> {
+    if x.len() < 5 {
+        return Vec::new();
+    }
+    let Ok(d) = ols_diagnostics(x, y) else {
+        return Vec::new();
+    };
+    d.studentized_external
+        .iter()
+        .enumerate()
+        .filter(|(_, t)| t.is_finite() && t.abs() > threshold)
+        .map(|(i, t)| (i, *t))
+        .collect()
+}
+
 /// Maps ±∞ (from a zero denominator) to NaN so that every undefined entry is NaN.
 fn undefined_if_nan(v: f64) -> f64 {
     if v.is_finite() { v } else { f64::NAN }

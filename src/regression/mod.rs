@@ -8,7 +8,8 @@
 //! - [`fit_line`]: OLS (faer QR), MA and SMA with smatr's `line.cis` intervals.
 //! - [`fit_power_law`]: y = A·x^b via log10–log10 lines.
 //! - [`slope_test`], [`elev_test`], [`slope_com`], [`elev_com`]: smatr's tests.
-//! - [`ols_diagnostics`], [`leave_one_out`]: influence of single points.
+//! - [`ols_diagnostics`], [`leave_one_out`], [`studentized_outliers`]: influence of single
+//!   points.
 //! - [`bootstrap_line`]: seeded case-resampling percentile intervals.
 //! - [`predict_ols`], [`back_transform`], [`inverse_predict_ols`]: prediction.
 //!
@@ -29,7 +30,9 @@ pub use bootstrap::{
     BcaInterval, BootstrapConfig, BootstrapResult, bca_interval, bootstrap_line,
     jackknife_influence, jackknife_line, quantile,
 };
-pub use diagnostics::{LeaveOneOut, OlsDiagnostics, leave_one_out, ols_diagnostics};
+pub use diagnostics::{
+    LeaveOneOut, OlsDiagnostics, leave_one_out, ols_diagnostics, studentized_outliers,
+};
 pub use error::RegressionError;
 pub use hypothesis::{
     CommonSlopeTest, ElevationComparison, ElevationTest, Group, GroupElevation, GroupLine,

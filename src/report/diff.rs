@@ -1,7 +1,9 @@
 //! `survey diff` as Markdown, ready to paste into a pull-request review.
 
-use crate::diff::{DatasetDiff, FieldChange, RecordSummary, SourceRef, Table2Change};
-use crate::survey::Var;
+use crate::analysis::release_diff::{
+    DatasetDiff, FieldChange, RecordSummary, SourceRef, Table2Change,
+};
+use crate::analysis::table2::Var;
 
 /// A Markdown table cell: no line breaks, `|` escaped.
 fn cell(s: &str) -> String {

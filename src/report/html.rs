@@ -4,6 +4,8 @@
 //! robots excluded from the fits are grey and carry their exclusion reason. Each class's
 //! fitted power law is drawn over its data range with the confidence band of the fitted
 //! line (the OLS mean interval of [`crate::regression::predict_ols`], back-transformed).
+//! The points, lines and bands are computed by [`crate::analysis::figure`]; this module
+//! only writes them as HTML and SVG.
 //!
 //! Each point is an SVG `<circle class="pt">` whose `data-*` attributes hold the robot's
 //! id, name, class, fit status, exclusion and its leg length, body length and mass as the
@@ -11,169 +13,11 @@
 
 use std::fmt::Write as _;
 
-use crate::dataset::{RobotClass, SurveyRow, SurveyTable};
-use crate::regression::{self, Method};
-use crate::survey::{Group, PowerLawRow, TABLE2_PAIRS, Table2, Var, log_points};
-
-/// One robot in one panel.
-#[derive(Debug, Clone)]
-pub struct FigurePoint {
-    pub id: String,
-    pub name: String,
-    pub class: RobotClass,
-    pub fit: bool,
-    pub exclusion: Option<String>,
-    /// Leg length, body length and mass cells of the compiled table (text as released).
-    pub values: [Option<String>; 3],
-    pub x: f64,
-    pub y: f64,
-}
-
-/// A class's fitted power law in one panel, with the confidence band of the line.
-#[derive(Debug, Clone)]
-pub struct FigureLine {
-    pub class: RobotClass,
-    pub fit: PowerLawRow,
-    /// (x, lower, upper) of the band of the fitted median line (empty for MA and SMA).
-    pub band: Vec<(f64, f64, f64)>,
-    /// Data range of x the line is drawn over.
-    pub x_range: (f64, f64),
-}
-
-/// One log–log panel: a Table 2 relation.
-#[derive(Debug, Clone)]
-pub struct FigurePanel {
-    pub x: Var,
-    pub y: Var,
-    pub points: Vec<FigurePoint>,
-    pub lines: Vec<FigureLine>,
-    /// The fit over all classes (Table 2's last column), listed but not drawn.
-    pub all: Option<PowerLawRow>,
-    /// Robots without both values (or with a value a log axis cannot show): (id, name, why).
-    pub missing: Vec<(String, String, String)>,
-}
-
-/// The data of the figure, computed from the table and its Table 2 fits.
-#[derive(Debug, Clone)]
-pub struct SurveyFigure {
-    pub version: String,
-    pub sha256: String,
-    pub frozen: bool,
-    pub method: Method,
-    pub confidence: f64,
-    pub panels: Vec<FigurePanel>,
-}
-
-fn row_point(r: &SurveyRow, x: Var, y: Var) -> Result<FigurePoint, String> {
-    let get = |v: Var| -> Result<f64, String> {
-        match r.number(v.field()) {
-            None => Err(format!("no {}", v.field())),
-            Some(n) if n <= 0.0 => Err(format!("{} = {n} is not positive", v.field())),
-            Some(n) => Ok(n),
-        }
-    };
-    let (px, py) = (get(x), get(y));
-    let (px, py) = match (px, py) {
-        (Ok(a), Ok(b)) => (a, b),
-        (Err(a), Err(b)) => return Err(format!("{a}, {b}")),
-        (Err(e), _) | (_, Err(e)) => return Err(e),
-    };
-    Ok(FigurePoint {
-        id: r.id.clone(),
-        name: r.name.clone(),
-        class: r.class,
-        fit: r.fit,
-        exclusion: r.exclusion.clone(),
-        values: Var::ALL.map(|v| r.cells.get(v.field()).filter(|s| !s.is_empty()).cloned()),
-        x: px,
-        y: py,
-    })
-}
-
-/// Builds the figure: every row of the table in every panel it has values for, and each
-/// class's Table 2 line with its band (OLS only: the band is the mean interval of the
-/// OLS prediction at each x).
-pub fn survey_figure(table: &SurveyTable, t2: &Table2) -> SurveyFigure {
-    let confidence = t2.fits.first().map(|f| f.confidence).unwrap_or(0.95);
-    let panels = TABLE2_PAIRS
-        .into_iter()
-        .map(|(x, y)| {
-            let mut points = Vec::new();
-            let mut missing = Vec::new();
-            for r in &table.rows {
-                match row_point(r, x, y) {
-                    Ok(p) => points.push(p),
-                    Err(why) => missing.push((r.id.clone(), r.name.clone(), why)),
-                }
-            }
-            let lines = RobotClass::FITTED
-                .into_iter()
-                .filter_map(|c| {
-                    let g = Group::Class(c);
-                    let fit = t2
-                        .fits
-                        .iter()
-                        .find(|f| f.class == g && f.x == x && f.y == y)?
-                        .clone();
-                    let pts = log_points(table, g, x, y).ok()?;
-                    let lo = pts.x.iter().copied().fold(f64::INFINITY, f64::min);
-                    let hi = pts.x.iter().copied().fold(f64::NEG_INFINITY, f64::max);
-                    if !(lo.is_finite() && hi.is_finite() && hi > lo) {
-                        return None;
-                    }
-                    let band = match t2.method {
-                        Method::Ols => {
-                            match regression::fit_line(&pts.lx, &pts.ly, Method::Ols, confidence) {
-                                Ok(line) => {
-                                    let steps = 48;
-                                    (0..=steps)
-                                        .filter_map(|i| {
-                                            let lx = lo.log10()
-                                                + (hi.log10() - lo.log10()) * i as f64
-                                                    / steps as f64;
-                                            let p = regression::predict_ols(&line, lx, confidence)
-                                                .ok()?;
-                                            let ci = p.mean_ci.map(|v| 10f64.powf(v));
-                                            Some((10f64.powf(lx), ci.lower, ci.upper))
-                                        })
-                                        .collect()
-                                }
-                                Err(_) => Vec::new(),
-                            }
-                        }
-                        _ => Vec::new(),
-                    };
-                    Some(FigureLine {
-                        class: c,
-                        fit,
-                        band,
-                        x_range: (lo, hi),
-                    })
-                })
-                .collect();
-            FigurePanel {
-                x,
-                y,
-                all: t2
-                    .fits
-                    .iter()
-                    .find(|f| f.class == Group::All && f.x == x && f.y == y)
-                    .cloned(),
-                points,
-                lines,
-                missing,
-            }
-        })
-        .collect();
-    SurveyFigure {
-        version: table.version.clone(),
-        sha256: table.sha256.clone(),
-        frozen: table.frozen,
-        method: t2.method,
-        confidence,
-        panels,
-    }
-}
+use super::ticks::{log_label, log_ticks_major_minor};
+use crate::analysis::figure::{FigurePanel, FigurePoint, SurveyFigure};
+use crate::analysis::table2::Var;
+use crate::dataset::RobotClass;
+use crate::regression::Method;
 
 /// HTML-escapes text for element content and quoted attribute values.
 fn esc(s: &str) -> String {
@@ -234,32 +78,8 @@ impl Axis {
     fn px(&self, v: f64) -> f64 {
         self.p0 + (v.log10() - self.lo) / (self.hi - self.lo) * (self.p1 - self.p0)
     }
-    /// (value, major) ticks: every decade, with 2 and 5 labelled when the axis spans
-    /// fewer than three decades; minor ticks at the other multiples.
     fn ticks(&self) -> Vec<(f64, bool)> {
-        let span = self.hi - self.lo;
-        let mut out = Vec::new();
-        for e in (self.lo.floor() as i32)..=(self.hi.ceil() as i32) {
-            for m in 1..10 {
-                let v = f64::from(m) * 10f64.powi(e);
-                let lv = v.log10();
-                if lv < self.lo || lv > self.hi {
-                    continue;
-                }
-                let major = m == 1 || (span < 3.0 && (m == 2 || m == 5));
-                out.push((v, major));
-            }
-        }
-        out
-    }
-}
-
-fn tick_label(v: f64) -> String {
-    let s = super::sig(v);
-    if s.contains('.') {
-        s.trim_end_matches('0').trim_end_matches('.').to_string()
-    } else {
-        s
+        log_ticks_major_minor(self.lo, self.hi)
     }
 }
 
@@ -280,6 +100,19 @@ fn title_case(v: Var) -> &'static str {
 }
 
 fn panel_svg(out: &mut String, index: usize, p: &FigurePanel, confidence: f64) {
+    let (xa, ya) = panel_axes(p);
+    panel_open(out, index, p);
+    grid_svg(out, &xa, &ya);
+    frame_svg(out, p);
+    lines_svg(out, index, p, &xa, &ya, confidence);
+    points_svg(out, p, &xa, &ya);
+    fits_key(out, p);
+    missing_list(out, p);
+    out.push_str("</figure>\n");
+}
+
+/// The axes of a panel: over its points and lines (x) and its points and bands (y).
+fn panel_axes(p: &FigurePanel) -> (Axis, Axis) {
     let xa = Axis::new(
         p.points
             .iter()
@@ -297,6 +130,11 @@ fn panel_svg(out: &mut String, index: usize, p: &FigurePanel, confidence: f64) {
         H - BOTTOM,
         TOP,
     );
+    (xa, ya)
+}
+
+/// The panel's caption, the opening `<svg>` and its clip path.
+fn panel_open(out: &mut String, index: usize, p: &FigurePanel) {
     let rel = format!("{} ∝ {}^b", p.y.symbol(), p.x.symbol());
     let _ = write!(
         out,
@@ -316,6 +154,9 @@ fn panel_svg(out: &mut String, index: usize, p: &FigurePanel, confidence: f64) {
         W - LEFT - RIGHT,
         H - TOP - BOTTOM
     );
+}
+
+fn grid_svg(out: &mut String, xa: &Axis, ya: &Axis) {
     // Grid and ticks.
     out.push_str("<g class=\"grid\">\n");
     for (v, major) in xa.ticks() {
@@ -331,7 +172,7 @@ fn panel_svg(out: &mut String, index: usize, p: &FigurePanel, confidence: f64) {
                 out,
                 "<text x=\"{x:.2}\" y=\"{:.2}\" class=\"tick\" text-anchor=\"middle\">{}</text>",
                 H - BOTTOM + 16.0,
-                tick_label(v)
+                log_label(v)
             );
         }
     }
@@ -349,11 +190,15 @@ fn panel_svg(out: &mut String, index: usize, p: &FigurePanel, confidence: f64) {
                 "<text x=\"{:.2}\" y=\"{:.2}\" class=\"tick\" text-anchor=\"end\">{}</text>",
                 LEFT - 6.0,
                 y + 4.0,
-                tick_label(v)
+                log_label(v)
             );
         }
     }
     out.push_str("</g>\n");
+}
+
+/// The frame and the axis titles.
+fn frame_svg(out: &mut String, p: &FigurePanel) {
     let _ = writeln!(
         out,
         "<rect class=\"frame\" x=\"{LEFT}\" y=\"{TOP}\" width=\"{}\" height=\"{}\"/>",
@@ -373,6 +218,16 @@ fn panel_svg(out: &mut String, index: usize, p: &FigurePanel, confidence: f64) {
         (TOP + H - BOTTOM) / 2.0,
         esc(var_label(p.y))
     );
+}
+
+fn lines_svg(
+    out: &mut String,
+    index: usize,
+    p: &FigurePanel,
+    xa: &Axis,
+    ya: &Axis,
+    confidence: f64,
+) {
     // Bands and lines, clipped to the plot area.
     let _ = writeln!(out, "<g clip-path=\"url(#clip-{index})\">");
     for l in &p.lines {
@@ -421,6 +276,10 @@ fn panel_svg(out: &mut String, index: usize, p: &FigurePanel, confidence: f64) {
         );
     }
     out.push_str("</g>\n");
+}
+
+/// The robots (closing the `<svg>`).
+fn points_svg(out: &mut String, p: &FigurePanel, xa: &Axis, ya: &Axis) {
     // Points: excluded (grey) first, fitted on top.
     let mut order: Vec<&FigurePoint> = p.points.iter().collect();
     order.sort_by_key(|q| q.fit);
@@ -451,6 +310,9 @@ fn panel_svg(out: &mut String, index: usize, p: &FigurePanel, confidence: f64) {
         );
     }
     out.push_str("</g>\n</svg>\n");
+}
+
+fn fits_key(out: &mut String, p: &FigurePanel) {
     // The fits of the panel, as a compact key.
     out.push_str("<ul class=\"fits\">\n");
     for l in &p.lines {
@@ -474,6 +336,9 @@ fn panel_svg(out: &mut String, index: usize, p: &FigurePanel, confidence: f64) {
         );
     }
     out.push_str("</ul>\n");
+}
+
+fn missing_list(out: &mut String, p: &FigurePanel) {
     if !p.missing.is_empty() {
         let _ = writeln!(
             out,
@@ -491,7 +356,6 @@ fn panel_svg(out: &mut String, index: usize, p: &FigurePanel, confidence: f64) {
         }
         out.push_str("</ul></details>\n");
     }
-    out.push_str("</figure>\n");
 }
 
 const STYLE: &str = r#"

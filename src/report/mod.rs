@@ -1,5 +1,5 @@
 //! Output formats, in one place: every command's data is rendered here as text, Markdown,
-//! LaTeX (booktabs), CSV or JSON; figures live in [`plot`].
+//! LaTeX (booktabs), CSV or JSON; figures live in [`plot`] (and a walk's in [`walk_plot`]).
 
 mod crosscheck;
 mod diff;
@@ -8,6 +8,8 @@ pub mod html;
 pub mod plot;
 pub mod separation;
 pub mod study;
+mod ticks;
+pub mod walk_plot;
 
 pub use diff::diff_md;
 
@@ -15,9 +17,9 @@ pub use crosscheck::{crosscheck_md, min_torque_text};
 
 use serde::Serialize;
 
+use crate::analysis::table2::{Group, PowerLawRow, TABLE2_PAIRS, Table2, Var};
 use crate::dataset::upstream::{ImportCheck, UpstreamImport};
 use crate::dataset::validate::ValidationReport;
-use crate::survey::{Group, PowerLawRow, TABLE2_PAIRS, Table2, Var};
 
 /// Output format of tables.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, clap::ValueEnum)]
@@ -272,7 +274,7 @@ fn table2_csv(t: &Table2) -> String {
 }
 
 /// `survey fit --explain`: per relation, the robots that move the exponent most.
-pub fn explain_text(e: &crate::survey::Explanation) -> String {
+pub fn explain_text(e: &crate::analysis::table2::Explanation) -> String {
     let mut out = format!(
         "Leave-one-out influence on the {} exponents ({}; dataset {}, {} fit)\n",
         e.class.label(),
@@ -324,7 +326,7 @@ pub(crate) fn sig(v: f64) -> String {
 }
 
 /// `survey predict` as text.
-pub fn prediction_text(p: &crate::predict::Prediction) -> String {
+pub fn prediction_text(p: &crate::analysis::prediction::Prediction) -> String {
     let pct = p.confidence * 100.0;
     let mut out = format!(
         "Prediction from the {} OLS fits of dataset {} (sha256 {}…)\n",
@@ -373,7 +375,7 @@ pub fn prediction_text(p: &crate::predict::Prediction) -> String {
         let fit_mass = p
             .quantities
             .iter()
-            .find(|q| q.quantity == crate::survey::Var::Mass);
+            .find(|q| q.quantity == crate::analysis::table2::Var::Mass);
         out.push_str(&format!(
             "scaling {} (L = {} m, m = {} kg; {}) by ×{}:\n",
             s.reference.name,
@@ -427,7 +429,7 @@ pub fn prediction_text(p: &crate::predict::Prediction) -> String {
 }
 
 /// `survey test slope` as text.
-pub fn slope_test_text(r: &crate::inference::SlopeTestReport) -> String {
+pub fn slope_test_text(r: &crate::analysis::inference::SlopeTestReport) -> String {
     format!(
         "{} {} ∝ {}^b (dataset {}, {}): b = {:.4}, {:.0}% CI [{:.4}, {:.4}], n = {}\nH0: {}: F = {:.4} on (1, {}) df, p = {:.3e}{}\n",
         r.class.as_str(),
@@ -453,7 +455,7 @@ pub fn slope_test_text(r: &crate::inference::SlopeTestReport) -> String {
 }
 
 /// `survey test common-slope` as text.
-pub fn comparison_text(r: &crate::inference::GroupComparisonReport) -> String {
+pub fn comparison_text(r: &crate::analysis::inference::GroupComparisonReport) -> String {
     let c = &r.common_slope;
     let mut out = format!(
         "{} ∝ {}^b across {} (dataset {}, {}):\n",
@@ -531,7 +533,7 @@ pub fn comparison_text(r: &crate::inference::GroupComparisonReport) -> String {
 }
 
 /// `survey laws` as Markdown.
-pub fn laws_md(t: &crate::laws::LawTable) -> String {
+pub fn laws_md(t: &crate::analysis::laws::LawTable) -> String {
     let mut out = format!(
         "# Scaling laws against leg length L (Table 1)\n\nDataset {}; robotics exponents recomputed by OLS with {:.0}% intervals.\n\n| quantity | isometric | biology | robotics (paper) |\n|---|---|---|---|\n",
         t.dataset.version,
@@ -641,7 +643,7 @@ pub fn walk_text(r: &crate::sim::WalkReport) -> String {
 }
 
 /// `survey sim scale` as text.
-pub fn scaling_text(s: &crate::scaling::ScalingStudy) -> String {
+pub fn scaling_text(s: &crate::study::scaling::ScalingStudy) -> String {
     let mut out = format!(
         "Scaling study of {}\n  {:>8} {:>10} {:>6} {:>10} {:>7} {:>8} {:>8} {:>8} {:>11}\n",
         s.design,

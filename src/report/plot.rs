@@ -7,8 +7,9 @@ use std::sync::Once;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
+use super::ticks::{log_label, log_ticks};
+use crate::analysis::table2::{Group, Table2, Var, points};
 use crate::dataset::{RobotClass, SurveyTable};
-use crate::survey::{Group, Table2, Var, points};
 
 static FONT: Once = Once::new();
 const FONT_BYTES: &[u8] = include_bytes!("../../assets/fonts/DejaVuSans.ttf");
@@ -59,17 +60,6 @@ pub struct Panel {
     pub series: Vec<Series>,
 }
 
-/// A tick label with at most 3 significant digits (log axes otherwise print float noise
-/// such as 0.30000000000000004).
-fn tick(v: &f64) -> String {
-    let s = super::sig(*v);
-    if s.contains('.') {
-        s.trim_end_matches('0').trim_end_matches('.').to_string()
-    } else {
-        s
-    }
-}
-
 fn bounds(values: impl Iterator<Item = f64>) -> (f64, f64) {
     let (lo, hi) = values
         .filter(|v| v.is_finite() && *v > 0.0)
@@ -81,40 +71,6 @@ fn bounds(values: impl Iterator<Item = f64>) -> (f64, f64) {
     } else {
         (0.01, 1.0)
     }
-}
-
-/// Tick positions of a log axis over [lo, hi]: labelled (bold) at 1, 2, 5 × 10^k (with 3
-/// added when the axis spans less than 1.5 decades), light grid lines at the other
-/// integers × 10^k. plotters' own log key points label every integer of the top decade,
-/// which runs the labels together ("0.70.80.91"), and draw a light line per key point,
-/// which packs into a grey band near a decade's end.
-fn log_ticks(lo: f64, hi: f64) -> (Vec<f64>, Vec<f64>) {
-    let (mut bold, mut light) = (Vec::new(), Vec::new());
-    if !(lo > 0.0 && hi > lo && lo.is_finite() && hi.is_finite()) {
-        return (bold, light);
-    }
-    let labelled: &[f64] = if (hi / lo).log10() < 1.5 {
-        &[1.0, 2.0, 3.0, 5.0]
-    } else {
-        &[1.0, 2.0, 5.0]
-    };
-    let (k0, k1) = (lo.log10().floor() as i32, hi.log10().ceil() as i32);
-    for k in k0..=k1 {
-        let decade = 10f64.powi(k);
-        for m in 1..=9 {
-            // Rounded to 12 significant digits so labels print as 0.3, not 0.30000000000000004.
-            let v = (m as f64 * decade * 1e12).round() / 1e12;
-            if v < lo || v > hi {
-                continue;
-            }
-            if labelled.contains(&(m as f64)) {
-                bold.push(v);
-            } else {
-                light.push(v);
-            }
-        }
-    }
-    (bold, light)
 }
 
 fn draw_panel<DB: DrawingBackend>(
@@ -165,8 +121,8 @@ fn draw_panel<DB: DrawingBackend>(
         .configure_mesh()
         .x_desc(&panel.x_label)
         .y_desc(&panel.y_label)
-        .x_label_formatter(&tick)
-        .y_label_formatter(&tick)
+        .x_label_formatter(&|v: &f64| log_label(*v))
+        .y_label_formatter(&|v: &f64| log_label(*v))
         .label_style(("sans-serif", 13))
         .draw()
         .map_err(|e| e.to_string())?;
@@ -313,8 +269,8 @@ pub fn survey_panels(table: &SurveyTable, t2: &Table2) -> Vec<Panel> {
 /// target's prediction and the L² / L³ scaling of the reference.
 pub fn prediction_panel(
     table: &SurveyTable,
-    pred: &crate::predict::Prediction,
-) -> Result<Panel, crate::predict::PredictError> {
+    pred: &crate::analysis::prediction::Prediction,
+) -> Result<Panel, crate::analysis::prediction::PredictError> {
     let all = points(table, Group::All, Var::LegLength, Var::Mass);
     let mut lo = all.iter().map(|p| p.1).fold(f64::INFINITY, f64::min);
     let mut hi = all.iter().map(|p| p.1).fold(f64::NEG_INFINITY, f64::max);
@@ -325,7 +281,8 @@ pub fn prediction_panel(
     let mut series = Vec::new();
     for c in RobotClass::FITTED {
         let g = Group::Class(c);
-        let (law, band) = crate::predict::mass_band(table, g, pred.confidence, [lo, hi])?;
+        let (law, band) =
+            crate::analysis::prediction::mass_band(table, g, pred.confidence, [lo, hi])?;
         series.push(Series {
             label: format!("{} m = {:.3}·L^{:.2}", c.label(), law.a, law.b),
             color: class_color(c),
@@ -387,12 +344,12 @@ pub fn prediction_panel(
 
 /// `survey sim scale --plot`: velocity and peak hip torque against leg length, log–log,
 /// with the fitted power laws.
-pub fn scaling_panels(s: &crate::scaling::ScalingStudy) -> Vec<Panel> {
+pub fn scaling_panels(s: &crate::study::scaling::ScalingStudy) -> Vec<Panel> {
     let walking: Vec<&crate::sim::WalkReport> = s.walks.iter().filter(|w| w.walks).collect();
     let panel = |title: &str,
                  y_label: &str,
                  y: fn(&crate::sim::WalkReport) -> f64,
-                 law: &Option<crate::scaling::StudyLaw>| Panel {
+                 law: &Option<crate::study::scaling::StudyLaw>| Panel {
         title: title.to_string(),
         x_label: "leg length L [m]".into(),
         y_label: y_label.to_string(),

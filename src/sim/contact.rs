@@ -253,7 +253,6 @@ pub fn patch_into(
     cut: Option<&Cut>,
     with_energy: bool,
 ) -> bool {
-    use std::f64::consts::{FRAC_PI_3, PI};
     // Ground normal e_z expressed in foot axes = third row of rot.
     let nf = Vector3::new(rot[(2, 0)], rot[(2, 1)], rot[(2, 2)]);
     let a2 = semi.component_mul(semi);
@@ -281,28 +280,8 @@ pub fn patch_into(
     let det_t = 1.0 / (l11 * l22);
     let u_max = (1.0 - r0 * r0).sqrt();
     // Section: the half-plane m·u ≥ d of the disc (None: no clipping).
-    let clip = match cut {
-        None => None,
-        Some(c) => {
-            // n·s ≥ offset on the plane: a·(s₀ + T u) ≥ offset ⇔ (Tᵀa)·u ≥ offset − a·s₀.
-            let a = Vector2::new(c.normal.x, c.normal.y);
-            let b = c.offset - a.dot(&Vector2::new(s0.x, s0.y));
-            let ta = t.transpose() * a;
-            let n = ta.norm();
-            if n <= 1e-12 {
-                // Cut plane parallel to the ground: the whole patch or nothing.
-                if b > 0.0 {
-                    return false;
-                }
-                None
-            } else {
-                let d = b / n;
-                if d >= u_max {
-                    return false;
-                }
-                if d <= -u_max { None } else { Some((ta / n, d)) }
-            }
-        }
+    let Some(clip) = section_clip(cut, &t, &s0, u_max) else {
+        return false;
     };
     p.r0 = r0;
     p.support_m = rho;
@@ -326,120 +305,244 @@ pub fn patch_into(
             .sqrt()
     };
     let r02 = r0 * r0;
+    let f = PatchFrame {
+        t,
+        det_t,
+        u_max,
+        r0,
+        r02,
+        one_m,
+        rho,
+        rho2,
+        abc,
+        modulus_pa,
+        sigma_min,
+        s0,
+        inv_a2,
+    };
     match clip {
-        None => {
-            p.elastic_force_n =
-                FRAC_PI_3 * modulus_pa * abc / rho * one_m * one_m * (1.0 + 2.0 * r0);
-            p.stiffness_n_per_m = 2.0 * PI * modulus_pa * abc * r0 * one_m / rho2;
-            p.energy_j = FRAC_PI_3 * modulus_pa * abc * (0.5 - r0 + r0.powi(3) - 0.5 * r0.powi(4));
-            let det_a = 1.0 / (det_t * det_t);
-            let a_inv = Matrix2::new(a22, -a12, -a12, a11) / det_a;
-            let j2 = 1.0 / 20.0 - r02 / 6.0 + r02 * r02 / 4.0 - 2.0 * r02 * r02 * r0 / 15.0;
-            p.second_moment = a_inv * (PI * modulus_pa * j2.max(0.0) / det_a.sqrt());
-            p.inner_radius_m = u_max * sigma_min;
-            // Pressure-weighted polar rule (radial Gauss–Legendre × uniform angle).
-            let mut wsum = 0.0;
-            // Stagger rings by half a sector so the 24 points cover the disc evenly.
-            let trig = ring_trig();
-            let sector = 2.0 * PI / N_ANGLE as f64 * u_max * u_max * det_t;
-            for ((&xi, &wi), ring) in GL_NODES.iter().zip(GL_WEIGHTS.iter()).zip(trig.iter()) {
-                let u = u_max * xi;
-                let pe = (1.0 - (r02 + u * u).sqrt()).max(0.0);
-                let wgt = wi * xi * pe;
-                for &(c, s) in ring {
-                    let k = p.quad_len;
-                    p.quad_offsets[k] = t * Vector2::new(u * c, u * s);
-                    p.quad_weights[k] = wgt;
-                    p.quad_area_m2[k] = wi * xi * sector;
-                    p.quad_pressure_pa[k] = modulus_pa * pe;
-                    wsum += wgt;
-                    p.quad_len += 1;
-                }
-            }
-            normalise(&mut p.quad_weights[..p.quad_len], wsum);
-        }
+        None => full_disc(p, &f, a11, a12, a22),
         Some((m, d)) => {
-            // Disc segment m·u ≥ d in polar-like coordinates about m: u = U cosφ m +
-            // U sinφ σ m⊥, φ ∈ [0, acos(d/U)], σ ∈ [−1, 1]; dA_u = U² sin²φ dφ dσ. The
-            // integrand is smooth in (φ, σ), so an 8 × 4 Gauss rule is accurate to ~1e-6.
-            let mp = Vector2::new(-m.y, m.x);
-            let cos_d = (d / u_max).clamp(-1.0, 1.0);
-            let phi_d = cos_d.acos();
-            // Angular nodes φ = h(1 ± ξⱼ), h = φ_d/2 (the Gauss nodes are symmetric): sin/cos
-            // by the addition theorem from h (half-angle formulas) and the four hξⱼ.
-            let h = 0.5 * phi_d;
-            let (ch, sh) = ((0.5 * (1.0 + cos_d)).sqrt(), (0.5 * (1.0 - cos_d)).sqrt());
-            let mut trig = [(0.0, 0.0); 8];
-            for jn in 0..4 {
-                let (sd, cd) = (h * GL8_NODES[4 + jn]).sin_cos();
-                trig[4 + jn] = (sh * cd + ch * sd, ch * cd - sh * sd);
-                trig[3 - jn] = (sh * cd - ch * sd, ch * cd + sh * sd);
-            }
-            let mut f0 = 0.0;
-            let mut f1 = Vector2::zeros();
-            let mut e_sum = 0.0;
-            let mut k = 0;
-            for (&wp, &(sp, cp)) in GL8_WEIGHTS.iter().zip(trig.iter()) {
-                let base = m * (u_max * cp);
-                let side = mp * (u_max * sp);
-                let jac_p = h * wp * u_max * u_max * sp * sp;
-                // The four chord nodes as lanes (packed arithmetic).
-                let mut ux = [0.0; 4];
-                let mut uy = [0.0; 4];
-                let mut wgt = [0.0; 4];
-                let mut jac = [0.0; 4];
-                for l in 0..4 {
-                    ux[l] = base.x + side.x * GL4_NODES[l];
-                    uy[l] = base.y + side.y * GL4_NODES[l];
-                    jac[l] = jac_p * GL4_WEIGHTS[l];
-                    let pe = (1.0 - (r02 + ux[l] * ux[l] + uy[l] * uy[l]).sqrt()).max(0.0);
-                    wgt[l] = jac[l] * pe;
-                }
-                for l in 0..4 {
-                    let off = t * Vector2::new(ux[l], uy[l]);
-                    f0 += wgt[l];
-                    f1 += off * wgt[l];
-                    if with_energy {
-                        let sp_world = Vector3::new(s0.x + off.x, s0.y + off.y, 0.0);
-                        e_sum += jac[l] * column_energy(&sp_world, center, rot, &inv_a2);
-                    }
-                    p.quad_offsets[k] = off;
-                    p.quad_weights[k] = wgt[l];
-                    p.quad_area_m2[k] = jac[l] * det_t;
-                    p.quad_pressure_pa[k] = modulus_pa * wgt[l] / jac[l].max(1e-300);
-                    k += 1;
-                }
-            }
-            if f0 <= 0.0 {
+            if !disc_segment(p, &f, m, d, center, rot, with_energy) {
                 return false;
             }
-            let shift = f1 / f0;
-            let scale = modulus_pa * det_t;
-            p.elastic_force_n = scale * f0;
-            p.cop = Vector3::new(s0.x + shift.x, s0.y + shift.y, 0.0);
-            p.energy_j = modulus_pa * det_t * e_sum;
-            let (mut sxx, mut sxy, mut syy) = (0.0, 0.0, 0.0);
-            for (off, &wgt) in p.quad_offsets[..k].iter_mut().zip(&p.quad_weights[..k]) {
-                *off -= shift;
-                sxx += off.x * off.x * wgt;
-                sxy += off.x * off.y * wgt;
-                syy += off.y * off.y * wgt;
-            }
-            let s2 = Matrix2::new(sxx, sxy, sxy, syy);
-            p.second_moment = s2 * scale;
-            p.quad_len = k;
-            normalise(&mut p.quad_weights[..k], f0);
-            // Slope for the implicit step: the full patch's, scaled by the clipped share.
-            let f_full = FRAC_PI_3 * modulus_pa * abc / rho * one_m * one_m * (1.0 + 2.0 * r0);
-            let k_full = 2.0 * PI * modulus_pa * abc * r0 * one_m / rho2;
-            p.stiffness_n_per_m = k_full * (p.elastic_force_n / f_full.max(1e-300)).min(1.0);
-            // Distance from the centre of pressure to the cut line bounds the inner disc.
-            let to_cut =
-                (m.dot(&(t.try_inverse().unwrap_or_else(Matrix2::identity) * shift)) - d).max(0.0);
-            p.inner_radius_m = (to_cut * sigma_min).min(u_max * sigma_min);
         }
     }
     p.cop.z = 0.0;
+    true
+}
+
+/// What both quadratures of a patch need: the disc-to-plane map `t` (and its determinant),
+/// the disc radius, the depth terms and the foot's constants.
+#[derive(Clone, Copy)]
+struct PatchFrame {
+    t: Matrix2<f64>,
+    det_t: f64,
+    u_max: f64,
+    r0: f64,
+    r02: f64,
+    one_m: f64,
+    rho: f64,
+    rho2: f64,
+    abc: f64,
+    modulus_pa: f64,
+    sigma_min: f64,
+    s0: Vector3<f64>,
+    inv_a2: Vector3<f64>,
+}
+
+/// The section's half-plane m·u ≥ d of the disc: Some(None) when it does not clip, None
+/// when it leaves no contact.
+#[inline]
+fn section_clip(
+    cut: Option<&Cut>,
+    t: &Matrix2<f64>,
+    s0: &Vector3<f64>,
+    u_max: f64,
+) -> Option<Option<(Vector2<f64>, f64)>> {
+    match cut {
+        None => Some(None),
+        Some(c) => {
+            // n·s ≥ offset on the plane: a·(s₀ + T u) ≥ offset ⇔ (Tᵀa)·u ≥ offset − a·s₀.
+            let a = Vector2::new(c.normal.x, c.normal.y);
+            let b = c.offset - a.dot(&Vector2::new(s0.x, s0.y));
+            let ta = t.transpose() * a;
+            let n = ta.norm();
+            if n <= 1e-12 {
+                // Cut plane parallel to the ground: the whole patch or nothing.
+                if b > 0.0 {
+                    return None;
+                }
+                Some(None)
+            } else {
+                let d = b / n;
+                if d >= u_max {
+                    return None;
+                }
+                if d <= -u_max {
+                    Some(None)
+                } else {
+                    Some(Some((ta / n, d)))
+                }
+            }
+        }
+    }
+}
+
+/// The whole disc: closed-form force, stiffness, energy and second moment, and the
+/// pressure-weighted polar rule.
+#[inline]
+fn full_disc(p: &mut Patch, f: &PatchFrame, a11: f64, a12: f64, a22: f64) {
+    use std::f64::consts::{FRAC_PI_3, PI};
+    let PatchFrame {
+        t,
+        det_t,
+        u_max,
+        r0,
+        r02,
+        one_m,
+        rho,
+        rho2,
+        abc,
+        modulus_pa,
+        sigma_min,
+        ..
+    } = *f;
+    p.elastic_force_n = FRAC_PI_3 * modulus_pa * abc / rho * one_m * one_m * (1.0 + 2.0 * r0);
+    p.stiffness_n_per_m = 2.0 * PI * modulus_pa * abc * r0 * one_m / rho2;
+    p.energy_j = FRAC_PI_3 * modulus_pa * abc * (0.5 - r0 + r0.powi(3) - 0.5 * r0.powi(4));
+    let det_a = 1.0 / (det_t * det_t);
+    let a_inv = Matrix2::new(a22, -a12, -a12, a11) / det_a;
+    let j2 = 1.0 / 20.0 - r02 / 6.0 + r02 * r02 / 4.0 - 2.0 * r02 * r02 * r0 / 15.0;
+    p.second_moment = a_inv * (PI * modulus_pa * j2.max(0.0) / det_a.sqrt());
+    p.inner_radius_m = u_max * sigma_min;
+    // Pressure-weighted polar rule (radial Gauss–Legendre × uniform angle).
+    let mut wsum = 0.0;
+    // Stagger rings by half a sector so the 24 points cover the disc evenly.
+    let trig = ring_trig();
+    let sector = 2.0 * PI / N_ANGLE as f64 * u_max * u_max * det_t;
+    for ((&xi, &wi), ring) in GL_NODES.iter().zip(GL_WEIGHTS.iter()).zip(trig.iter()) {
+        let u = u_max * xi;
+        let pe = (1.0 - (r02 + u * u).sqrt()).max(0.0);
+        let wgt = wi * xi * pe;
+        for &(c, s) in ring {
+            let k = p.quad_len;
+            p.quad_offsets[k] = t * Vector2::new(u * c, u * s);
+            p.quad_weights[k] = wgt;
+            p.quad_area_m2[k] = wi * xi * sector;
+            p.quad_pressure_pa[k] = modulus_pa * pe;
+            wsum += wgt;
+            p.quad_len += 1;
+        }
+    }
+    normalise(&mut p.quad_weights[..p.quad_len], wsum);
+}
+
+/// A disc segment (the foot's section clips the patch): Gauss rule over the segment;
+/// false when no pressure is left.
+#[inline]
+fn disc_segment(
+    p: &mut Patch,
+    f: &PatchFrame,
+    m: Vector2<f64>,
+    d: f64,
+    center: &Vector3<f64>,
+    rot: &Matrix3<f64>,
+    with_energy: bool,
+) -> bool {
+    use std::f64::consts::{FRAC_PI_3, PI};
+    let PatchFrame {
+        t,
+        det_t,
+        u_max,
+        r0,
+        r02,
+        one_m,
+        rho,
+        rho2,
+        abc,
+        modulus_pa,
+        sigma_min,
+        s0,
+        inv_a2,
+    } = *f;
+    // Disc segment m·u ≥ d in polar-like coordinates about m: u = U cosφ m +
+    // U sinφ σ m⊥, φ ∈ [0, acos(d/U)], σ ∈ [−1, 1]; dA_u = U² sin²φ dφ dσ. The
+    // integrand is smooth in (φ, σ), so an 8 × 4 Gauss rule is accurate to ~1e-6.
+    let mp = Vector2::new(-m.y, m.x);
+    let cos_d = (d / u_max).clamp(-1.0, 1.0);
+    let phi_d = cos_d.acos();
+    // Angular nodes φ = h(1 ± ξⱼ), h = φ_d/2 (the Gauss nodes are symmetric): sin/cos
+    // by the addition theorem from h (half-angle formulas) and the four hξⱼ.
+    let h = 0.5 * phi_d;
+    let (ch, sh) = ((0.5 * (1.0 + cos_d)).sqrt(), (0.5 * (1.0 - cos_d)).sqrt());
+    let mut trig = [(0.0, 0.0); 8];
+    for jn in 0..4 {
+        let (sd, cd) = (h * GL8_NODES[4 + jn]).sin_cos();
+        trig[4 + jn] = (sh * cd + ch * sd, ch * cd - sh * sd);
+        trig[3 - jn] = (sh * cd - ch * sd, ch * cd + sh * sd);
+    }
+    let mut f0 = 0.0;
+    let mut f1 = Vector2::zeros();
+    let mut e_sum = 0.0;
+    let mut k = 0;
+    for (&wp, &(sp, cp)) in GL8_WEIGHTS.iter().zip(trig.iter()) {
+        let base = m * (u_max * cp);
+        let side = mp * (u_max * sp);
+        let jac_p = h * wp * u_max * u_max * sp * sp;
+        // The four chord nodes as lanes (packed arithmetic).
+        let mut ux = [0.0; 4];
+        let mut uy = [0.0; 4];
+        let mut wgt = [0.0; 4];
+        let mut jac = [0.0; 4];
+        for l in 0..4 {
+            ux[l] = base.x + side.x * GL4_NODES[l];
+            uy[l] = base.y + side.y * GL4_NODES[l];
+            jac[l] = jac_p * GL4_WEIGHTS[l];
+            let pe = (1.0 - (r02 + ux[l] * ux[l] + uy[l] * uy[l]).sqrt()).max(0.0);
+            wgt[l] = jac[l] * pe;
+        }
+        for l in 0..4 {
+            let off = t * Vector2::new(ux[l], uy[l]);
+            f0 += wgt[l];
+            f1 += off * wgt[l];
+            if with_energy {
+                let sp_world = Vector3::new(s0.x + off.x, s0.y + off.y, 0.0);
+                e_sum += jac[l] * column_energy(&sp_world, center, rot, &inv_a2);
+            }
+            p.quad_offsets[k] = off;
+            p.quad_weights[k] = wgt[l];
+            p.quad_area_m2[k] = jac[l] * det_t;
+            p.quad_pressure_pa[k] = modulus_pa * wgt[l] / jac[l].max(1e-300);
+            k += 1;
+        }
+    }
+    if f0 <= 0.0 {
+        return false;
+    }
+    let shift = f1 / f0;
+    let scale = modulus_pa * det_t;
+    p.elastic_force_n = scale * f0;
+    p.cop = Vector3::new(s0.x + shift.x, s0.y + shift.y, 0.0);
+    p.energy_j = modulus_pa * det_t * e_sum;
+    let (mut sxx, mut sxy, mut syy) = (0.0, 0.0, 0.0);
+    for (off, &wgt) in p.quad_offsets[..k].iter_mut().zip(&p.quad_weights[..k]) {
+        *off -= shift;
+        sxx += off.x * off.x * wgt;
+        sxy += off.x * off.y * wgt;
+        syy += off.y * off.y * wgt;
+    }
+    let s2 = Matrix2::new(sxx, sxy, sxy, syy);
+    p.second_moment = s2 * scale;
+    p.quad_len = k;
+    normalise(&mut p.quad_weights[..k], f0);
+    // Slope for the implicit step: the full patch's, scaled by the clipped share.
+    let f_full = FRAC_PI_3 * modulus_pa * abc / rho * one_m * one_m * (1.0 + 2.0 * r0);
+    let k_full = 2.0 * PI * modulus_pa * abc * r0 * one_m / rho2;
+    p.stiffness_n_per_m = k_full * (p.elastic_force_n / f_full.max(1e-300)).min(1.0);
+    // Distance from the centre of pressure to the cut line bounds the inner disc.
+    let to_cut = (m.dot(&(t.try_inverse().unwrap_or_else(Matrix2::identity) * shift)) - d).max(0.0);
+    p.inner_radius_m = (to_cut * sigma_min).min(u_max * sigma_min);
     true
 }
 

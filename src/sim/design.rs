@@ -1,4 +1,5 @@
-//! Walker designs as data (TOML), their validation, and scaling to another leg length.
+//! Walker designs as data (TOML) and their validation; their scaling to another leg length
+//! is in `similarity.rs`.
 
 use std::path::Path;
 
@@ -11,10 +12,8 @@ use super::contact::ContactParams;
 use super::control::Controller;
 use super::effects::EffectSpec;
 use super::error::SimError;
-use super::model::{FootSection, Hardstop, Leg, Model, State};
-
-/// Standard gravity [m/s²].
-pub const GRAVITY_MPS2: f64 = 9.81;
+use super::model::{FootSection, GRAVITY_MPS2, Hardstop, Leg, Model};
+use super::state::State;
 
 /// Built-in designs: (name, path in the repository, text). Bundled so the binary works
 /// from any directory. The `-ref` designs are ../shared/research/walker-models.json in this
@@ -51,47 +50,6 @@ pub const BUILTIN_DESIGNS: [(&str, &str, &str); 6] = [
         include_str!("../../dataset/walkers/reference/zippy-spherical-ref.toml"),
     ),
 ];
-
-/// How mass follows leg length when a design is scaled.
-#[derive(
-    Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize, Default, clap::ValueEnum,
-)]
-#[serde(rename_all = "lowercase")]
-pub enum MassLaw {
-    /// m ∝ L² (the survey's lower-biped trend).
-    #[default]
-    L2,
-    /// m ∝ L³ (isometric, constant density).
-    L3,
-}
-
-impl MassLaw {
-    pub fn exponent(self) -> f64 {
-        match self {
-            MassLaw::L2 => 2.0,
-            MassLaw::L3 => 3.0,
-        }
-    }
-}
-
-/// Rule for the contact parameters when a design is scaled.
-#[derive(
-    Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize, Default, clap::ValueEnum,
-)]
-#[serde(rename_all = "kebab-case")]
-pub enum ContactScaling {
-    /// Dynamic similarity: the foot's static sinkage stays the same fraction of L and the
-    /// Hunt–Crossley damping the same fraction of the gait's speeds, so E ∝ m/L²
-    /// (since F = πEδ² must scale like m·g with δ ∝ L) and d ∝ L^(−1/2) (d·v constant with
-    /// v ∝ √(gL)); μ unchanged. For m ∝ L² this keeps E fixed. Default: isolates the effect
-    /// of size on the gait from that of foot softness.
-    #[default]
-    Similar,
-    /// Same foot material at every size (what a real robot built of the same rubber has):
-    /// E, d, μ unchanged. For m ∝ L³ large robots then sink relatively deeper
-    /// (δ/L ∝ L^(1/2)).
-    FixedMaterial,
-}
 
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -311,6 +269,26 @@ fn number_at<'a>(root: &'a mut toml::Value, path: &str) -> Result<&'a mut toml::
     }
 }
 
+/// A design field's check: `ok` and finite, or an error naming the field and the file.
+struct FieldCheck<'a> {
+    origin: &'a str,
+}
+
+impl FieldCheck<'_> {
+    fn check(&self, field: &str, v: f64, ok: bool, why: &str) -> Result<(), SimError> {
+        if ok && v.is_finite() {
+            Ok(())
+        } else {
+            Err(SimError::InvalidValue {
+                origin: self.origin.to_string(),
+                field: field.to_string(),
+                value: v.to_string(),
+                reason: why.to_string(),
+            })
+        }
+    }
+}
+
 impl Design {
     /// Parses and validates a design; `origin` (file name) appears in error messages.
     pub fn from_toml_str(text: &str, origin: &str) -> Result<Design, SimError> {
@@ -365,123 +343,142 @@ impl Design {
     }
 
     fn validate(&self, origin: &str) -> Result<(), SimError> {
-        let check = |field: &str, v: f64, ok: bool, why: &str| -> Result<(), SimError> {
-            if ok && v.is_finite() {
-                Ok(())
-            } else {
-                Err(SimError::InvalidValue {
-                    origin: origin.to_string(),
-                    field: field.to_string(),
-                    value: v.to_string(),
-                    reason: why.to_string(),
-                })
-            }
-        };
+        let ck = FieldCheck { origin };
+        self.validate_geometry(&ck)?;
+        self.validate_mass(&ck)?;
+        self.validate_contact(&ck)?;
+        self.validate_control(&ck)?;
+        self.validate_hardstop(&ck)?;
+        self.validate_start(&ck)?;
+        self.validate_criteria(&ck)?;
+        for (n, e) in self.effects.iter().enumerate() {
+            e.validate(origin, &format!("effects[{n}]"))?;
+        }
+        Ok(())
+    }
+
+    /// The geometry: positive lengths, a foot section within the foot.
+    fn validate_geometry(&self, ck: &FieldCheck) -> Result<(), SimError> {
         let g = &self.geometry;
-        check(
+        ck.check(
             "geometry.leg_length_m",
             g.leg_length_m,
             g.leg_length_m > 0.0,
             "must be > 0",
         )?;
-        check(
+        ck.check(
             "geometry.body_length_m",
             g.body_length_m,
             g.body_length_m > 0.0,
             "must be > 0",
         )?;
         for (i, a) in g.foot_semi_axes_m.iter().enumerate() {
-            check(
+            ck.check(
                 &format!("geometry.foot_semi_axes_m[{i}]"),
                 *a,
                 *a > 0.0,
                 "must be > 0",
             )?;
         }
-        check(
+        ck.check(
             "geometry.hip_half_width_over_l",
             g.hip_half_width_over_l,
             g.hip_half_width_over_l >= 0.0,
             "must be ≥ 0",
         )?;
-        check(
+        ck.check(
             "geometry.foot_center_lateral_over_l",
             g.foot_center_lateral_over_l,
             true,
             "must be finite",
         )?;
-        check(
+        ck.check(
             "geometry.foot_center_forward_over_l",
             g.foot_center_forward_over_l,
             true,
             "must be finite",
         )?;
         if let Some(c) = g.foot_section_cut_over_l {
-            check(
+            ck.check(
                 "geometry.foot_section_cut_over_l",
                 c,
                 c.abs() < 1.0,
                 "must be within ±1",
             )?;
         }
+        Ok(())
+    }
+
+    /// Mass, centre of mass and inertia box.
+    fn validate_mass(&self, ck: &FieldCheck) -> Result<(), SimError> {
         let m = &self.mass;
-        check(
+        ck.check(
             "mass.total_mass_kg",
             m.total_mass_kg,
             m.total_mass_kg > 0.0,
             "must be > 0",
         )?;
-        check(
+        ck.check(
             "mass.leg_com_height_over_l",
             m.leg_com_height_over_l,
             m.leg_com_height_over_l > 0.0 && m.leg_com_height_over_l < 1.0,
             "must be in (0, 1)",
         )?;
-        check(
+        ck.check(
             "mass.leg_com_forward_over_l",
             m.leg_com_forward_over_l,
             true,
             "must be finite",
         )?;
         for (i, b) in m.leg_inertia_box_over_l.iter().enumerate() {
-            check(
+            ck.check(
                 &format!("mass.leg_inertia_box_over_l[{i}]"),
                 *b,
                 *b > 0.0,
                 "must be > 0",
             )?;
         }
+        Ok(())
+    }
+
+    /// Contact: modulus, dissipation, relaxation, friction.
+    fn validate_contact(&self, ck: &FieldCheck) -> Result<(), SimError> {
         let c = &self.contact;
-        check(
+        ck.check(
             "contact.hydroelastic_modulus_pa",
             c.hydroelastic_modulus_pa,
             c.hydroelastic_modulus_pa > 0.0 && c.hydroelastic_modulus_pa <= 1e12,
             "must be in (0, 1e12] Pa (1e12 is five times steel's Young's modulus)",
         )?;
-        check(
+        ck.check(
             "contact.hunt_crossley_dissipation_s_per_m",
             c.hunt_crossley_dissipation_s_per_m,
             c.hunt_crossley_dissipation_s_per_m >= 0.0,
             "must be ≥ 0",
         )?;
-        check(
+        ck.check(
             "contact.relaxation_time_s",
             c.relaxation_time_s,
             c.relaxation_time_s >= 0.0 && c.relaxation_time_s < 1.0,
             "must be in [0, 1) s",
         )?;
-        check(
+        ck.check(
             "contact.friction_mu",
             c.friction_mu,
             c.friction_mu >= 0.0,
             "must be ≥ 0",
         )?;
-        check(
+        ck.check(
             "contact.stiction_speed_mps",
             c.stiction_speed_mps,
             c.stiction_speed_mps > 0.0,
             "must be > 0",
         )?;
+        Ok(())
+    }
+
+    /// The controller's amplitude, frequency, gains and torque.
+    fn validate_control(&self, ck: &FieldCheck) -> Result<(), SimError> {
         match &self.control {
             ControlSpec::ServoSine {
                 amplitude_deg,
@@ -490,31 +487,31 @@ impl Design {
                 kd_over_mgl_sqrt_l_over_g,
                 torque_limit_nm,
             } => {
-                check(
+                ck.check(
                     "control.amplitude_deg",
                     *amplitude_deg,
                     amplitude_deg.abs() < 90.0,
                     "must be within ±90",
                 )?;
-                check(
+                ck.check(
                     "control.frequency_hz",
                     *frequency_hz,
                     *frequency_hz > 0.0,
                     "must be > 0",
                 )?;
-                check(
+                ck.check(
                     "control.kp_over_mgl",
                     *kp_over_mgl,
                     *kp_over_mgl >= 0.0,
                     "must be ≥ 0",
                 )?;
-                check(
+                ck.check(
                     "control.kd_over_mgl_sqrt_l_over_g",
                     *kd_over_mgl_sqrt_l_over_g,
                     *kd_over_mgl_sqrt_l_over_g >= 0.0,
                     "must be ≥ 0",
                 )?;
-                check(
+                ck.check(
                     "control.torque_limit_nm",
                     *torque_limit_nm,
                     *torque_limit_nm >= 0.0,
@@ -525,13 +522,13 @@ impl Design {
                 torque_nm,
                 frequency_hz,
             } => {
-                check(
+                ck.check(
                     "control.torque_nm",
                     *torque_nm,
                     *torque_nm >= 0.0,
                     "must be ≥ 0",
                 )?;
-                check(
+                ck.check(
                     "control.frequency_hz",
                     *frequency_hz,
                     *frequency_hz > 0.0,
@@ -539,85 +536,97 @@ impl Design {
                 )?;
             }
         }
+        Ok(())
+    }
+
+    /// The hip limits, when the design has them.
+    fn validate_hardstop(&self, ck: &FieldCheck) -> Result<(), SimError> {
         if let Some(h) = &self.hardstop {
-            check(
+            ck.check(
                 "hardstop.limit_deg",
                 h.limit_deg,
                 h.limit_deg > 0.0 && h.limit_deg < 180.0,
                 "must be in (0, 180)",
             )?;
-            check(
+            ck.check(
                 "hardstop.stiffness_over_mgl",
                 h.stiffness_over_mgl,
                 h.stiffness_over_mgl > 0.0,
                 "must be > 0",
             )?;
-            check(
+            ck.check(
                 "hardstop.damping_over_mgl_sqrt_l_over_g",
                 h.damping_over_mgl_sqrt_l_over_g,
                 h.damping_over_mgl_sqrt_l_over_g >= 0.0,
                 "must be ≥ 0",
             )?;
         }
+        Ok(())
+    }
+
+    /// Initial conditions and the time step.
+    fn validate_start(&self, ck: &FieldCheck) -> Result<(), SimError> {
         let i = &self.initial;
-        check(
+        ck.check(
             "initial.roll_deg",
             i.roll_deg,
             i.roll_deg.abs() < 45.0,
             "must be within ±45",
         )?;
-        check(
+        ck.check(
             "initial.seed_angle_sd_deg",
             i.seed_angle_sd_deg,
             i.seed_angle_sd_deg >= 0.0,
             "must be ≥ 0",
         )?;
-        check(
+        ck.check(
             "initial.seed_rate_sd_over_sqrt_g_over_l",
             i.seed_rate_sd_over_sqrt_g_over_l,
             i.seed_rate_sd_over_sqrt_g_over_l >= 0.0,
             "must be ≥ 0",
         )?;
-        check(
+        ck.check(
             "numerics.time_step_s",
             self.numerics.time_step_s,
             self.numerics.time_step_s > 0.0,
             "must be > 0",
         )?;
+        Ok(())
+    }
+
+    /// Walk and fall criteria, and the ground slope.
+    fn validate_criteria(&self, ck: &FieldCheck) -> Result<(), SimError> {
         let k = &self.criteria;
-        check(
+        ck.check(
             "criteria.walk_speed_threshold_over_sqrt_gl",
             k.walk_speed_threshold_over_sqrt_gl,
             k.walk_speed_threshold_over_sqrt_gl >= 0.0,
             "must be ≥ 0",
         )?;
-        check(
+        ck.check(
             "criteria.fall_hip_height_over_l",
             k.fall_hip_height_over_l,
             k.fall_hip_height_over_l > 0.0,
             "must be > 0",
         )?;
-        check(
+        ck.check(
             "criteria.fall_roll_deg",
             k.fall_roll_deg,
             k.fall_roll_deg > 0.0,
             "must be > 0",
         )?;
-        check(
+        ck.check(
             "criteria.fall_pitch_deg",
             k.fall_pitch_deg,
             k.fall_pitch_deg > 0.0,
             "must be > 0",
         )?;
-        check(
+        ck.check(
             "ground.slope_deg",
             self.ground.slope_deg,
             self.ground.slope_deg.abs() < 45.0,
             "must be within ±45",
         )?;
-        for (n, e) in self.effects.iter().enumerate() {
-            e.validate(origin, &format!("effects[{n}]"))?;
-        }
         Ok(())
     }
 
@@ -799,66 +808,6 @@ impl Design {
     /// m·g·L [N·m], the natural torque unit of the design.
     pub fn mgl_nm(&self) -> f64 {
         self.mass.total_mass_kg * GRAVITY_MPS2 * self.geometry.leg_length_m
-    }
-
-    /// The design scaled to leg length `leg_length_m`: lengths ∝ L, mass ∝ L² or L³
-    /// (inertia ∝ m·L² follows from the box fractions), frequencies ∝ L^(−1/2), torques
-    /// ∝ m·L, time step ∝ L^(1/2), contact by `contact_scaling`.
-    pub fn scaled(
-        &self,
-        leg_length_m: f64,
-        mass_law: MassLaw,
-        contact_scaling: ContactScaling,
-    ) -> Result<Design, SimError> {
-        if !(leg_length_m > 0.0 && leg_length_m.is_finite()) {
-            return Err(SimError::InvalidOption {
-                option: "leg_length_m".into(),
-                reason: format!("must be finite and > 0, got {leg_length_m}"),
-            });
-        }
-        let s = leg_length_m / self.geometry.leg_length_m;
-        let mu = s.powf(mass_law.exponent());
-        let time = s.sqrt();
-        let mut d = self.clone();
-        d.geometry.leg_length_m *= s;
-        d.geometry.body_length_m *= s;
-        for a in d.geometry.foot_semi_axes_m.iter_mut() {
-            *a *= s;
-        }
-        d.mass.total_mass_kg *= mu;
-        match contact_scaling {
-            ContactScaling::Similar => {
-                d.contact.hydroelastic_modulus_pa *= mu / (s * s);
-                d.contact.hunt_crossley_dissipation_s_per_m /= time;
-                // A time scale: ∝ the gait's √(L/g) (walker-models.json's rule).
-                d.contact.relaxation_time_s *= time;
-            }
-            ContactScaling::FixedMaterial => {}
-        }
-        // Numerical regularisation, not a material property: keep it a fixed fraction of √(gL).
-        d.contact.stiction_speed_mps *= time;
-        match &mut d.control {
-            ControlSpec::ServoSine {
-                frequency_hz,
-                torque_limit_nm,
-                ..
-            } => {
-                *frequency_hz /= time;
-                *torque_limit_nm *= mu * s;
-            }
-            ControlSpec::BangBang {
-                torque_nm,
-                frequency_hz,
-            } => {
-                *frequency_hz /= time;
-                *torque_nm *= mu * s;
-            }
-        }
-        d.numerics.time_step_s *= time;
-        for e in d.effects.iter_mut() {
-            *e = e.scaled(s, mu, contact_scaling);
-        }
-        Ok(d)
     }
 
     /// The rigid-body model, with the contact effects of `effects` applied to its contact

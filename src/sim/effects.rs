@@ -21,9 +21,8 @@ use nalgebra::{SMatrix, SVector};
 use serde::{Deserialize, Serialize};
 
 use super::contact::ContactParams;
-use super::design::ContactScaling;
 use super::error::SimError;
-use super::model::{Kinematics, State};
+use super::state::{Kinematics, State};
 
 /// Longest accepted actuation latency [s]: far beyond any servo's, and it bounds the
 /// command buffer (latency / time step entries).
@@ -103,71 +102,6 @@ pub enum EffectSpec {
 }
 
 impl EffectSpec {
-    /// Scales the effect with the robot by dynamic similarity (lengths ∝ L, times ∝ √(L/g)):
-    /// * torques ∝ m·g·L (Coulomb friction torque);
-    /// * viscous damping (torque per rate) ∝ m·g·L·√(L/g);
-    /// * rates ∝ √(g/L) (stiction rate, no-load speed, lash crossing rate);
-    /// * times ∝ √(L/g) (latency);
-    /// * lengths ∝ L (rolling-resistance length);
-    /// * μ and angles unchanged (friction coefficient, backlash);
-    /// * the ground modulus as the foot's modulus under `contact_scaling`: ∝ m/L² when
-    ///   similar (the floor's share of the sinkage stays the same fraction of L), unchanged
-    ///   for a fixed material (the same floor).
-    pub fn scaled(
-        &self,
-        length_ratio: f64,
-        mass_ratio: f64,
-        contact_scaling: ContactScaling,
-    ) -> EffectSpec {
-        let torque = mass_ratio * length_ratio;
-        let time = length_ratio.sqrt();
-        match *self {
-            EffectSpec::HipViscousDamping {
-                damping_nms_per_rad,
-            } => EffectSpec::HipViscousDamping {
-                damping_nms_per_rad: damping_nms_per_rad * torque * time,
-            },
-            EffectSpec::HipCoulombFriction {
-                friction_torque_nm,
-                stiction_rate_rad_s,
-            } => EffectSpec::HipCoulombFriction {
-                friction_torque_nm: friction_torque_nm * torque,
-                stiction_rate_rad_s: stiction_rate_rad_s / time,
-            },
-            EffectSpec::MotorTorqueSpeed {
-                no_load_speed_rad_s,
-            } => EffectSpec::MotorTorqueSpeed {
-                no_load_speed_rad_s: no_load_speed_rad_s / time,
-            },
-            EffectSpec::FrictionCoefficient { friction_mu } => {
-                EffectSpec::FrictionCoefficient { friction_mu }
-            }
-            EffectSpec::SoftGround { ground_modulus_pa } => EffectSpec::SoftGround {
-                ground_modulus_pa: match contact_scaling {
-                    ContactScaling::Similar => {
-                        ground_modulus_pa * mass_ratio / (length_ratio * length_ratio)
-                    }
-                    ContactScaling::FixedMaterial => ground_modulus_pa,
-                },
-            },
-            EffectSpec::RollingResistance {
-                rolling_resistance_length_m,
-            } => EffectSpec::RollingResistance {
-                rolling_resistance_length_m: rolling_resistance_length_m * length_ratio,
-            },
-            EffectSpec::ActuationLatency { latency_s } => EffectSpec::ActuationLatency {
-                latency_s: latency_s * time,
-            },
-            EffectSpec::HipBacklash {
-                backlash_deg,
-                crossing_rate_rad_s,
-            } => EffectSpec::HipBacklash {
-                backlash_deg,
-                crossing_rate_rad_s: crossing_rate_rad_s / time,
-            },
-        }
-    }
-
     /// Checks parameter signs and ranges; `origin` names the file for the error message.
     pub fn validate(&self, origin: &str, field: &str) -> Result<(), SimError> {
         let check = |name: &str, v: f64, ok: bool, why: &str| {

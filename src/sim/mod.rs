@@ -7,13 +7,15 @@
 //!   closed-form normal force / centre of pressure / rolling resistance, patch-integrated
 //!   regularised Coulomb friction with torsional moment.
 //! * [`control`]: position servo (Mugatu) and bang-bang torque with hardstops (Zippy).
-//! * [`design`]: designs as TOML data, scaling with leg length.
+//! * [`state`]: the generalized state and the kinematics of a configuration.
+//! * [`design`]: designs as TOML data and their validation.
+//! * [`similarity`]: scaling a design and its effects with leg length (mass law, contact
+//!   scaling; gravity fixed).
 //! * [`effects`]: optional unmodelled physics as data, switched on per design: hip effects
 //!   (viscous and Coulomb friction, motor torque–speed line, actuation latency, backlash) as
 //!   plug-ins, contact effects (friction coefficient, soft ground, rolling resistance) through
 //!   the contact parameters.
 //! * [`walk`]: running a walk and its gait metrics ([`WalkReport`]).
-//! * [`plot`]: SVG plot of a walk.
 //!
 //! Self-contained: depends only on external crates and std.
 
@@ -23,21 +25,20 @@ pub mod design;
 pub mod effects;
 pub mod error;
 pub mod model;
-pub mod plot;
+pub mod similarity;
+pub mod state;
 pub mod walk;
 
 pub use contact::{
     ContactParams, Cut, Patch, PatchWrench, patch, patch_forces, patch_into, patch_wrench,
 };
 pub use control::{Command, Controller};
-pub use design::{BUILTIN_DESIGNS, ContactScaling, Design, GRAVITY_MPS2, MassLaw};
+pub use design::{BUILTIN_DESIGNS, Design};
 pub use effects::{Effect, EffectContext, EffectSpec, GeneralizedForce};
 pub use error::SimError;
-pub use model::{
-    Energy, FootSection, Hardstop, Kinematics, Leg, Matrix7, Model, Simulator, State, StepInfo,
-    Vector7,
-};
-pub use plot::{render_svg, write_plot_svg};
+pub use model::{Energy, FootSection, GRAVITY_MPS2, Hardstop, Leg, Model, Simulator, StepInfo};
+pub use similarity::{ContactScaling, MassLaw};
+pub use state::{Kinematics, Matrix7, State, Vector7};
 pub use walk::{
     TrajectorySample, WalkOptions, WalkReport, WalkResult, WalkSetup, hip_frame_attitude,
     prepare_walk, read_trajectory_csv, report_from_trajectory, run_setup, simulate_walk,

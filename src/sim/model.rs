@@ -21,17 +21,18 @@
 //! hardstops, servo gains, effect dampings) so the stiff terms stay stable at a time step
 //! set by the gait, not by the contact.
 
-use nalgebra::{Matrix3, SMatrix, SVector, UnitQuaternion, Vector3};
+use nalgebra::{Matrix3, SMatrix, UnitQuaternion, Vector3};
 use serde::Serialize;
 
 use super::contact::{self, ContactParams, Cut, Patch};
 use super::control::Controller;
 use super::effects::{Effect, EffectContext, GeneralizedForce};
+use super::state::{Kinematics, Matrix7, State, Vector7};
 
-/// 7-vector of generalized velocities / forces (v, ω, q̇).
-pub type Vector7 = SVector<f64, 7>;
-/// 7×7 matrix (mass, damping).
-pub type Matrix7 = SMatrix<f64, 7, 7>;
+/// Standard gravity [m/s²]. A constant of the model (a slope tilts it, see
+/// [`Model::gravity_mps2`]); the similarity rules (`similarity.rs`) keep it fixed.
+pub const GRAVITY_MPS2: f64 = 9.81;
+
 type Jac = SMatrix<f64, 3, 7>;
 
 /// One rigid leg (frame origin at the hip point).
@@ -77,46 +78,6 @@ pub struct Model {
     pub gravity_mps2: Vector3<f64>,
     /// Contact with the ground (off for free-flight tests).
     pub ground_contact: bool,
-}
-
-/// Generalized state.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct State {
-    /// Hip point, world [m].
-    pub hip_position_m: Vector3<f64>,
-    /// Orientation of the left leg (leg → world).
-    pub orientation: UnitQuaternion<f64>,
-    /// Hip angle q [rad].
-    pub hip_angle_rad: f64,
-    /// Hip point velocity, world [m/s].
-    pub hip_velocity_mps: Vector3<f64>,
-    /// Left-leg angular velocity in the left-leg frame [rad/s].
-    pub angular_velocity_rad_s: Vector3<f64>,
-    /// Hip rate q̇ [rad/s].
-    pub hip_rate_rad_s: f64,
-}
-
-impl State {
-    /// Generalized velocity vector ν.
-    pub fn velocity(&self) -> Vector7 {
-        let v = self.hip_velocity_mps;
-        let w = self.angular_velocity_rad_s;
-        Vector7::from_column_slice(&[v.x, v.y, v.z, w.x, w.y, w.z, self.hip_rate_rad_s])
-    }
-
-    fn set_velocity(&mut self, nu: &Vector7) {
-        self.hip_velocity_mps = Vector3::new(nu[0], nu[1], nu[2]);
-        self.angular_velocity_rad_s = Vector3::new(nu[3], nu[4], nu[5]);
-        self.hip_rate_rad_s = nu[6];
-    }
-
-    /// True when every component is finite.
-    pub fn is_finite(&self) -> bool {
-        self.velocity().iter().all(|x| x.is_finite())
-            && self.hip_position_m.iter().all(|x| x.is_finite())
-            && self.orientation.coords.iter().all(|x| x.is_finite())
-            && self.hip_angle_rad.is_finite()
-    }
 }
 
 fn skew(v: &Vector3<f64>) -> Matrix3<f64> {
@@ -183,19 +144,6 @@ fn rot_y(q: f64) -> Matrix3<f64> {
     Matrix3::new(c, 0.0, s, 0.0, 1.0, 0.0, -s, 0.0, c)
 }
 
-/// Kinematic quantities of one configuration.
-#[derive(Clone, Copy, Debug)]
-pub struct Kinematics {
-    /// Leg rotations (leg → world), [left, right].
-    pub rot: [Matrix3<f64>; 2],
-    /// Hip axis in world.
-    pub axis_w: Vector3<f64>,
-    /// World angular velocities of the legs.
-    pub omega_w: [Vector3<f64>; 2],
-    /// Centre-of-mass positions relative to the hip point, world.
-    pub com_offset_w: [Vector3<f64>; 2],
-}
-
 /// Breakdown of the mechanical energy [J].
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
 pub struct Energy {
@@ -223,6 +171,93 @@ pub struct StepInfo {
 }
 
 impl Model {
+    /// Gravity and velocity-product (Coriolis/centrifugal) terms, as wrenches at the COMs.
+    #[inline]
+    fn add_body_forces(&self, s: &State, kin: &Kinematics, tau: &mut Vector7) {
+        let w0 = kin.omega_w[0];
+        let alpha_bias = [Vector3::zeros(), w0.cross(&kin.axis_w) * s.hip_rate_rad_s];
+        for (k, (leg, alpha_b)) in self.legs.iter().zip(alpha_bias.iter()).enumerate() {
+            let r = kin.com_offset_w[k];
+            let w = kin.omega_w[k];
+            // I_w·x = R (I_c (Rᵀx)) (cheaper than forming I_w).
+            let rk = kin.rot[k];
+            let iw_mul = |x: &Vector3<f64>| rk * (leg.inertia_com_kgm2 * (rk.transpose() * x));
+            let a_bias = alpha_b.cross(&r) + w.cross(&w.cross(&r));
+            let f = self.gravity_mps2 * leg.mass_kg - a_bias * leg.mass_kg;
+            let m = -(iw_mul(alpha_b) + w.cross(&iw_mul(&w)));
+            Model::add_wrench(tau, k, kin, &r, &f, &m);
+        }
+    }
+
+    /// Foot contacts: their wrenches into `tau`, their damping (normal, with h × stiffness,
+    /// friction and rolling) into the upper triangle of `damp`.
+    #[allow(clippy::too_many_arguments)]
+    #[inline]
+    fn add_contacts(
+        &self,
+        s: &State,
+        kin: &Kinematics,
+        nu: &Vector7,
+        h: f64,
+        tau: &mut Vector7,
+        damp: &mut Matrix7,
+        info: &mut StepInfo,
+    ) {
+        let mut patch = Patch::EMPTY;
+        for k in 0..2 {
+            if !self.patch_of_foot(k, s, kin, false, &mut patch) {
+                continue;
+            }
+            let p = &patch;
+            info.feet_in_contact += 1;
+            let r = p.cop - s.hip_position_m;
+            let jp = Model::point_jacobian(k, kin, &r);
+            let ja = Model::angular_jacobian(k, kin);
+            let v_cop = jp * nu;
+            let wr = contact::patch_wrench(p, &self.contact, &v_cop, &kin.omega_w[k]);
+            info.normal_force_n[k] = wr.force.z.max(0.0);
+            Model::add_wrench(tau, k, kin, &r, &wr.force, &wr.moment);
+            // Normal: damping plus h × stiffness (implicit in position along the normal).
+            let cn = wr.normal_damping + h * p.stiffness_n_per_m;
+            for a in 0..7 {
+                let ja_n = jp[(2, a)] * cn;
+                for b in a..7 {
+                    damp[(a, b)] += ja_n * jp[(2, b)];
+                }
+            }
+            // Friction acts on (v_x, v_y, ω_z) of the patch.
+            let mut jc = Jac::zeros();
+            jc.row_mut(0).copy_from(&jp.row(0));
+            jc.row_mut(1).copy_from(&jp.row(1));
+            jc.row_mut(2).copy_from(&ja.row(2));
+            add_jt_k_j_upper(damp, &jc, &wr.friction_damping, 0);
+            if wr.rolling_damping[(0, 0)] != 0.0 || wr.rolling_damping[(1, 1)] != 0.0 {
+                // J_a is zero in the translational columns.
+                add_jt_k_j_upper(damp, &ja, &wr.rolling_damping, 3);
+            }
+        }
+    }
+
+    /// The hip's hardstops: a one-sided spring and damper beyond the limit.
+    #[inline]
+    fn add_hardstop(&self, s: &State, h: f64, tau: &mut Vector7, damp: &mut Matrix7) {
+        if let Some(hs) = self.hardstop {
+            let q = s.hip_angle_rad;
+            let e = q.abs() - hs.limit_rad;
+            if e > 0.0 {
+                // One-sided (Hunt–Crossley-like) stop: spring plus damping on the inward rate,
+                // never pulling the leg back onto the stop while it leaves.
+                let sign = q.signum();
+                let push =
+                    hs.stiffness_nm_per_rad * e + hs.damping_nms_per_rad * sign * s.hip_rate_rad_s;
+                if push > 0.0 {
+                    tau[6] -= sign * push;
+                    damp[(6, 6)] += hs.damping_nms_per_rad + h * hs.stiffness_nm_per_rad;
+                }
+            }
+        }
+    }
+
     pub fn total_mass_kg(&self) -> f64 {
         self.legs[0].mass_kg + self.legs[1].mass_kg
     }
@@ -415,8 +450,7 @@ impl Model {
     /// Static sinkage of one spherical foot carrying the whole weight, √(m g/(π E))
     /// (F = π E δ² for δ ≪ R): how far a start is lowered below just touching.
     pub fn single_foot_sinkage_m(&self) -> f64 {
-        (self.total_mass_kg() * super::design::GRAVITY_MPS2
-            / (std::f64::consts::PI * self.contact.modulus_pa))
+        (self.total_mass_kg() * GRAVITY_MPS2 / (std::f64::consts::PI * self.contact.modulus_pa))
             .sqrt()
     }
 
@@ -494,87 +528,48 @@ impl Simulator {
         let mut tau = Vector7::zeros();
         let mut damp = Matrix7::zeros();
         let mut info = StepInfo::default();
-
-        // Gravity and velocity-product (Coriolis/centrifugal) terms, as wrenches at the COMs.
-        let w0 = kin.omega_w[0];
-        let alpha_bias = [Vector3::zeros(), w0.cross(&kin.axis_w) * s.hip_rate_rad_s];
-        for (k, (leg, alpha_b)) in model.legs.iter().zip(alpha_bias.iter()).enumerate() {
-            let r = kin.com_offset_w[k];
-            let w = kin.omega_w[k];
-            // I_w·x = R (I_c (Rᵀx)) (cheaper than forming I_w).
-            let rk = &kin.rot[k];
-            let iw_mul = |x: &Vector3<f64>| rk * (leg.inertia_com_kgm2 * (rk.transpose() * x));
-            let a_bias = alpha_b.cross(&r) + w.cross(&w.cross(&r));
-            let f = model.gravity_mps2 * leg.mass_kg - a_bias * leg.mass_kg;
-            let m = -(iw_mul(alpha_b) + w.cross(&iw_mul(&w)));
-            Model::add_wrench(&mut tau, k, &kin, &r, &f, &m);
-        }
-
-        // Foot contacts.
-        let mut patch = Patch::EMPTY;
-        for k in 0..2 {
-            if !model.patch_of_foot(k, &s, &kin, false, &mut patch) {
-                continue;
-            }
-            let p = &patch;
-            info.feet_in_contact += 1;
-            let r = p.cop - s.hip_position_m;
-            let jp = Model::point_jacobian(k, &kin, &r);
-            let ja = Model::angular_jacobian(k, &kin);
-            let v_cop = jp * nu;
-            let wr = contact::patch_wrench(p, &model.contact, &v_cop, &kin.omega_w[k]);
-            info.normal_force_n[k] = wr.force.z.max(0.0);
-            Model::add_wrench(&mut tau, k, &kin, &r, &wr.force, &wr.moment);
-            // Normal: damping plus h × stiffness (implicit in position along the normal).
-            let cn = wr.normal_damping + h * p.stiffness_n_per_m;
-            for a in 0..7 {
-                let ja_n = jp[(2, a)] * cn;
-                for b in a..7 {
-                    damp[(a, b)] += ja_n * jp[(2, b)];
-                }
-            }
-            // Friction acts on (v_x, v_y, ω_z) of the patch.
-            let mut jc = Jac::zeros();
-            jc.row_mut(0).copy_from(&jp.row(0));
-            jc.row_mut(1).copy_from(&jp.row(1));
-            jc.row_mut(2).copy_from(&ja.row(2));
-            add_jt_k_j_upper(&mut damp, &jc, &wr.friction_damping, 0);
-            if wr.rolling_damping[(0, 0)] != 0.0 || wr.rolling_damping[(1, 1)] != 0.0 {
-                // J_a is zero in the translational columns.
-                add_jt_k_j_upper(&mut damp, &ja, &wr.rolling_damping, 3);
-            }
-        }
-
+        model.add_body_forces(&s, &kin, &mut tau);
+        model.add_contacts(&s, &kin, &nu, h, &mut tau, &mut damp, &mut info);
         // The contact terms filled the upper triangle only.
         for a in 0..7 {
             for b in 0..a {
                 damp[(a, b)] = damp[(b, a)];
             }
         }
+        model.add_hardstop(&s, h, &mut tau, &mut damp);
+        let (torque, torque_slope, limit) =
+            self.actuator_and_effects(&s, &kin, &mut tau, &mut damp);
+        let (dnu, applied) = velocity_change(&mass, &damp, &tau, h, torque, torque_slope, limit);
+        let nu_new = nu + dnu;
+        info.actuator_torque_nm = applied;
+        let mut ns = s;
+        ns.set_velocity(&nu_new);
+        ns.hip_position_m += ns.hip_velocity_mps * h;
+        ns.orientation *= UnitQuaternion::from_scaled_axis(ns.angular_velocity_rad_s * h);
+        ns.orientation.renormalize_fast();
+        ns.hip_angle_rad += ns.hip_rate_rad_s * h;
+        self.state = ns;
+        self.time_s += h;
+        info
+    }
 
-        // Hardstops.
-        if let Some(hs) = model.hardstop {
-            let q = s.hip_angle_rad;
-            let e = q.abs() - hs.limit_rad;
-            if e > 0.0 {
-                // One-sided (Hunt–Crossley-like) stop: spring plus damping on the inward rate,
-                // never pulling the leg back onto the stop while it leaves.
-                let sign = q.signum();
-                let push =
-                    hs.stiffness_nm_per_rad * e + hs.damping_nms_per_rad * sign * s.hip_rate_rad_s;
-                if push > 0.0 {
-                    tau[6] -= sign * push;
-                    damp[(6, 6)] += hs.damping_nms_per_rad + h * hs.stiffness_nm_per_rad;
-                }
-            }
-        }
-
-        // Actuator, then effects (which may reshape the actuator torque and add forces).
+    /// Actuator, then effects (which may reshape the actuator torque and add forces): the
+    /// hip torque, its slope against the hip rate and the servo's torque limit; the effects'
+    /// generalized forces are added to `tau` and `damp`.
+    #[inline]
+    fn actuator_and_effects(
+        &mut self,
+        s: &State,
+        kin: &Kinematics,
+        tau: &mut Vector7,
+        damp: &mut Matrix7,
+    ) -> (f64, f64, Option<f64>) {
+        let h = self.dt_s;
         let ctx = EffectContext {
             time_s: self.time_s,
             dt_s: h,
-            state: &s,
-            kinematics: &kin,
+            state: s,
+            kinematics: kin,
         };
         // The servo's PD torque is implicit in the hip motion (slope k_d + h·k_p); its
         // torque limit bounds the torque the step *applies*, τ₀ − slope·Δq̇, as Drake's
@@ -602,39 +597,43 @@ impl Simulator {
         for e in self.effects.iter_mut() {
             e.generalized_force(&ctx, &mut gf);
         }
-        tau += gf.force;
-        damp += gf.damping;
-
-        // Linearly implicit velocity update.
-        let a0 = mass + damp * h;
-        let solve = |torque: f64, slope: f64| {
-            let mut a = a0;
-            a[(6, 6)] += slope * h;
-            let mut rhs = tau * h;
-            rhs[6] += torque * h;
-            match cholesky_solve(&a, &rhs) {
-                Some(x) => x,
-                None => a.lu().solve(&rhs).unwrap_or_else(Vector7::zeros),
-            }
-        };
-        let mut dnu = solve(torque, torque_slope);
-        let mut applied = torque - torque_slope * dnu[6];
-        if let Some(lim) = limit
-            && applied.abs() > lim
-        {
-            applied = lim.copysign(applied);
-            dnu = solve(applied, 0.0);
-        }
-        let nu_new = nu + dnu;
-        info.actuator_torque_nm = applied;
-        let mut ns = s;
-        ns.set_velocity(&nu_new);
-        ns.hip_position_m += ns.hip_velocity_mps * h;
-        ns.orientation *= UnitQuaternion::from_scaled_axis(ns.angular_velocity_rad_s * h);
-        ns.orientation.renormalize_fast();
-        ns.hip_angle_rad += ns.hip_rate_rad_s * h;
-        self.state = ns;
-        self.time_s += h;
-        info
+        *tau += gf.force;
+        *damp += gf.damping;
+        (torque, torque_slope, limit)
     }
+}
+
+/// Linearly implicit velocity update: Δν from (M + h·D)Δν = h·τ with the hip torque and
+/// its slope, and the torque the step applies (clamped to the servo's limit by solving
+/// again with the limit as a constant torque).
+#[inline]
+fn velocity_change(
+    mass: &Matrix7,
+    damp: &Matrix7,
+    tau: &Vector7,
+    h: f64,
+    torque: f64,
+    torque_slope: f64,
+    limit: Option<f64>,
+) -> (Vector7, f64) {
+    let a0 = mass + damp * h;
+    let solve = |torque: f64, slope: f64| {
+        let mut a = a0;
+        a[(6, 6)] += slope * h;
+        let mut rhs = tau * h;
+        rhs[6] += torque * h;
+        match cholesky_solve(&a, &rhs) {
+            Some(x) => x,
+            None => a.lu().solve(&rhs).unwrap_or_else(Vector7::zeros),
+        }
+    };
+    let mut dnu = solve(torque, torque_slope);
+    let mut applied = torque - torque_slope * dnu[6];
+    if let Some(lim) = limit
+        && applied.abs() > lim
+    {
+        applied = lim.copysign(applied);
+        dnu = solve(applied, 0.0);
+    }
+    (dnu, applied)
 }

@@ -6,9 +6,11 @@ use std::path::Path;
 use nalgebra::Matrix3;
 use serde::Serialize;
 
-use super::design::{ContactScaling, CriteriaSpec, Design, GRAVITY_MPS2, MassLaw};
+use super::design::{CriteriaSpec, Design};
 use super::error::SimError;
-use super::model::{Model, Simulator, State, StepInfo};
+use super::model::{GRAVITY_MPS2, Model, Simulator, StepInfo};
+use super::similarity::{ContactScaling, MassLaw};
+use super::state::State;
 
 /// Share of the normal load a foot must carry to become the stance foot (step counting).
 const STANCE_LOAD_SHARE: f64 = 0.75;

@@ -6,12 +6,12 @@
 //! m ∝ L² and L⁴ for m ∝ L³; attitude angles are unchanged. These are truths from
 //! outside the simulator, and they test that its scaling rules are mutually consistent.
 
-use robot_survey::scaling::scaling_study;
 use robot_survey::sim::{ContactScaling, Design, MassLaw, WalkOptions};
+use robot_survey::study::scaling::scaling_study;
 
 const SIZES: [f64; 3] = [0.05, 0.153, 0.6];
 
-fn study(mass_law: MassLaw) -> robot_survey::scaling::ScalingStudy {
+fn study(mass_law: MassLaw) -> robot_survey::study::scaling::ScalingStudy {
     let design = Design::builtin("mugatu").expect("bundled design");
     let base = WalkOptions {
         mass_law,
@@ -64,7 +64,7 @@ fn scaling_study_is_deterministic_whatever_the_thread_schedule() {
     };
     let a = scaling_study(&design, &SIZES, &base, &|| {}).expect("runs");
     let b = scaling_study(&design, &SIZES, &base, &|| {}).expect("runs");
-    let bits = |s: &robot_survey::scaling::ScalingStudy| {
+    let bits = |s: &robot_survey::study::scaling::ScalingStudy| {
         s.walks
             .iter()
             .map(|w| (w.velocity_mps.to_bits(), w.peak_torque_nm.to_bits()))

@@ -16,13 +16,13 @@ use std::collections::{BTreeMap, BTreeSet};
 
 use serde::Serialize;
 
+use crate::analysis::table2::{DatasetRef, Group, Numeric, TABLE2_PAIRS, Var, fit_group};
 use crate::dataset::release::{self, SurveyRow, SurveyTable, parse_semver};
 use crate::dataset::validate::validate;
 use crate::dataset::{
     Dataset, DatasetError, Datum, FieldType, Problem, Robot, Severity, SourceKind, Value,
 };
 use crate::regression::Method;
-use crate::survey::{DatasetRef, Group, Numeric, TABLE2_PAIRS, Var, fit_group};
 
 /// Columns of the compiled table that identify a robot rather than hold a value.
 const IDENTITY_FIELDS: [&str; 5] = ["id", "name", "class", "fit", "exclusion"];
@@ -271,63 +271,7 @@ pub fn diff(
             continue;
         };
         let robot = live.get(row.id.as_str()).map(|(_, r)| *r);
-        let mut fields = Vec::new();
-        let identity = [
-            ("name", Some(old.name.clone()), Some(row.name.clone())),
-            (
-                "class",
-                Some(old.class.as_str().to_string()),
-                Some(row.class.as_str().to_string()),
-            ),
-            ("fit", Some(old.fit.to_string()), Some(row.fit.to_string())),
-            ("exclusion", old.exclusion.clone(), row.exclusion.clone()),
-        ];
-        for (field, o, n) in identity {
-            if !same_cell(o.as_deref(), n.as_deref()) {
-                fields.push(FieldChange {
-                    field: field.to_string(),
-                    unit: None,
-                    relative_change: None,
-                    old: o,
-                    new: n,
-                    sources: Vec::new(),
-                    at: None,
-                    note: None,
-                });
-            }
-        }
-        for c in &columns {
-            let o = old.cells.get(*c).filter(|s| !s.is_empty());
-            let n = row.cells.get(*c).filter(|s| !s.is_empty());
-            if same_cell(o.map(String::as_str), n.map(String::as_str)) {
-                continue;
-            }
-            let num = |s: Option<&String>| s.and_then(|s| s.parse::<f64>().ok());
-            let is_measure = ds
-                .vocab
-                .get(c)
-                .is_some_and(|f| f.field_type == FieldType::Number);
-            let relative_change = match (num(o), num(n)) {
-                (Some(a), Some(b)) if is_measure && a != 0.0 && a.is_finite() && b.is_finite() => {
-                    Some(b / a - 1.0)
-                }
-                _ => None,
-            };
-            fields.push(FieldChange {
-                field: c.to_string(),
-                unit: unit(c),
-                old: o.cloned(),
-                new: n.cloned(),
-                relative_change,
-                sources: robot.map(|r| value_sources(r, c)).unwrap_or_default(),
-                at: robot
-                    .and_then(|r| r.values.get(*c))
-                    .and_then(|d| d.at.clone()),
-                note: robot
-                    .and_then(|r| r.values.get(*c))
-                    .and_then(|d| d.note.clone()),
-            });
-        }
+        let fields = field_changes(ds, &columns, old, row, robot);
         if !fields.is_empty() {
             changed.push(ChangedRecord {
                 id: row.id.clone(),
@@ -354,6 +298,76 @@ pub fn diff(
         resolved_problems,
         table2: table2_changes(&before, &after, method, confidence),
     })
+}
+
+/// What changed in one record: its identity (name, class, fit, exclusion), then each
+/// value column, with the new value's sources.
+fn field_changes(
+    ds: &Dataset,
+    columns: &[&str],
+    old: &SurveyRow,
+    row: &SurveyRow,
+    robot: Option<&Robot>,
+) -> Vec<FieldChange> {
+    let unit = |field: &str| ds.vocab.get(field).map(|f| f.unit.clone());
+    let mut fields = Vec::new();
+    let identity = [
+        ("name", Some(old.name.clone()), Some(row.name.clone())),
+        (
+            "class",
+            Some(old.class.as_str().to_string()),
+            Some(row.class.as_str().to_string()),
+        ),
+        ("fit", Some(old.fit.to_string()), Some(row.fit.to_string())),
+        ("exclusion", old.exclusion.clone(), row.exclusion.clone()),
+    ];
+    for (field, o, n) in identity {
+        if !same_cell(o.as_deref(), n.as_deref()) {
+            fields.push(FieldChange {
+                field: field.to_string(),
+                unit: None,
+                relative_change: None,
+                old: o,
+                new: n,
+                sources: Vec::new(),
+                at: None,
+                note: None,
+            });
+        }
+    }
+    for c in columns {
+        let o = old.cells.get(*c).filter(|s| !s.is_empty());
+        let n = row.cells.get(*c).filter(|s| !s.is_empty());
+        if same_cell(o.map(String::as_str), n.map(String::as_str)) {
+            continue;
+        }
+        let num = |s: Option<&String>| s.and_then(|s| s.parse::<f64>().ok());
+        let is_measure = ds
+            .vocab
+            .get(c)
+            .is_some_and(|f| f.field_type == FieldType::Number);
+        let relative_change = match (num(o), num(n)) {
+            (Some(a), Some(b)) if is_measure && a != 0.0 && a.is_finite() && b.is_finite() => {
+                Some(b / a - 1.0)
+            }
+            _ => None,
+        };
+        fields.push(FieldChange {
+            field: c.to_string(),
+            unit: unit(c),
+            old: o.cloned(),
+            new: n.cloned(),
+            relative_change,
+            sources: robot.map(|r| value_sources(r, c)).unwrap_or_default(),
+            at: robot
+                .and_then(|r| r.values.get(*c))
+                .and_then(|d| d.at.clone()),
+            note: robot
+                .and_then(|r| r.values.get(*c))
+                .and_then(|d| d.note.clone()),
+        });
+    }
+    fields
 }
 
 /// Value columns of both tables (after's order first, then columns only the release has),

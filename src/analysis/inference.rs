@@ -5,11 +5,11 @@
 
 use serde::Serialize;
 
+use crate::analysis::table2::{DatasetRef, Group, Var, isometric_exponent, log_points};
 use crate::dataset::{RobotClass, SurveyTable};
 use crate::regression::{
     self, CommonSlopeTest, ElevationComparison, Method, RegressionError, SlopeTest,
 };
-use crate::survey::{DatasetRef, Group, Var, isometric_exponent, log_points};
 
 /// `survey test slope`.
 #[derive(Debug, Clone, Serialize)]

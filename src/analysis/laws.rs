@@ -5,9 +5,9 @@
 
 use serde::{Deserialize, Serialize};
 
+use crate::analysis::table2::{DatasetRef, Group, Numeric, Var, fit_group};
 use crate::dataset::{Dataset, DatasetError, SurveyTable};
 use crate::regression::Method;
-use crate::survey::{DatasetRef, Group, Numeric, Var, fit_group};
 
 /// File of the laws, relative to the dataset root.
 pub const LAWS_FILE: &str = "laws/table1.toml";

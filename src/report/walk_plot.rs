@@ -9,36 +9,8 @@ use std::path::Path;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
-use super::error::SimError;
-use super::walk::TrajectorySample;
-
-fn nice_ticks(lo: f64, hi: f64, n: usize) -> Vec<f64> {
-    let span = (hi - lo).max(1e-12);
-    let raw = span / n as f64;
-    let mag = 10f64.powf(raw.log10().floor());
-    let step = [1.0, 2.0, 5.0, 10.0]
-        .iter()
-        .map(|m| m * mag)
-        .find(|s| *s >= raw)
-        .unwrap_or(10.0 * mag);
-    let mut t = (lo / step).ceil() * step;
-    let mut out = Vec::new();
-    while t <= hi + 1e-9 * span {
-        out.push(t);
-        t += step;
-    }
-    out
-}
-
-fn fmt_tick(v: f64) -> String {
-    if v.abs() >= 100.0 || v == v.round() {
-        format!("{v:.0}")
-    } else if (v * 10.0).round() == v * 10.0 {
-        format!("{v:.1}")
-    } else {
-        format!("{v:.3}")
-    }
-}
+use super::ticks::{linear_label, linear_ticks};
+use crate::sim::{SimError, TrajectorySample};
 
 struct Label {
     x: i32,
@@ -67,27 +39,27 @@ fn grid_and_frame(
 ) -> Result<(), String> {
     let e = |x: DrawingAreaErrorKind<_>| x.to_string();
     let grey = RGBColor(225, 225, 225);
-    for tx in nice_ticks(x0, x1, ticks) {
+    for tx in linear_ticks(x0, x1, ticks) {
         c.draw_series(LineSeries::new([(tx, y0), (tx, y1)], &grey))
             .map_err(e)?;
         let (px, py) = c.as_coord_spec().translate(&(tx, y0));
         labels.push(Label {
             x: px,
             y: py + 18,
-            text: fmt_tick(tx),
+            text: linear_label(tx),
             anchor: "middle",
             color: "black",
             rotate: false,
         });
     }
-    for ty in nice_ticks(y0, y1, ticks) {
+    for ty in linear_ticks(y0, y1, ticks) {
         c.draw_series(LineSeries::new([(x0, ty), (x1, ty)], &grey))
             .map_err(e)?;
         let (px, py) = c.as_coord_spec().translate(&(x0, ty));
         labels.push(Label {
             x: px - 6,
             y: py + 4,
-            text: fmt_tick(ty),
+            text: linear_label(ty),
             anchor: "end",
             color: "black",
             rotate: false,

@@ -10,9 +10,9 @@
 
 use serde::Serialize;
 
+use crate::analysis::table2::{DatasetRef, Group, Var, log_points};
 use crate::dataset::SurveyTable;
 use crate::regression::{self, BiasCorrection, Method, PowerLawFit, RegressionError};
-use crate::survey::{DatasetRef, Group, Var, log_points};
 
 /// A reference robot or design to scale from.
 #[derive(Debug, Clone, Serialize)]

@@ -1,165 +1,15 @@
-//! The paper's analyses over a survey table: Table 2 (power laws per class), outliers,
-//! and designer predictions. Numbers come from [`crate::regression`]; this module only
-//! chooses the data (which robots, which variables) and names the results.
+//! The paper's Table 2 over a survey table (power laws per class) and the influence of
+//! single robots on it (`--explain`). Numbers come from [`crate::regression`]; this module
+//! only chooses the data (which robots, which variables) and names the results.
 
 use serde::Serialize;
 
-use crate::dataset::{RobotClass, SurveyRow, SurveyTable};
+use crate::dataset::{RobotClass, SurveyTable};
 use crate::regression::{self, Method};
 
-/// A survey variable, in the paper's words.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Serialize)]
-#[serde(rename_all = "snake_case")]
-pub enum Var {
-    LegLength,
-    BodyLength,
-    Mass,
-}
-
-impl Var {
-    pub const ALL: [Var; 3] = [Var::LegLength, Var::BodyLength, Var::Mass];
-    /// Column of the compiled table.
-    pub fn field(self) -> &'static str {
-        match self {
-            Var::LegLength => "leg_length_m",
-            Var::BodyLength => "body_length_m",
-            Var::Mass => "mass_kg",
-        }
-    }
-    pub fn as_str(self) -> &'static str {
-        match self {
-            Var::LegLength => "leg_length",
-            Var::BodyLength => "body_length",
-            Var::Mass => "mass",
-        }
-    }
-    pub fn parse(s: &str) -> Option<Var> {
-        Var::ALL
-            .into_iter()
-            .find(|v| v.as_str() == s || v.field() == s)
-    }
-    /// Symbol in the paper (L, L_B, m).
-    pub fn symbol(self) -> &'static str {
-        match self {
-            Var::LegLength => "L",
-            Var::BodyLength => "L_B",
-            Var::Mass => "m",
-        }
-    }
-    pub fn unit(self) -> &'static str {
-        match self {
-            Var::LegLength | Var::BodyLength => "m",
-            Var::Mass => "kg",
-        }
-    }
-}
-
-/// The (x, y) pairs of Table 2, in the paper's row order.
-pub const TABLE2_PAIRS: [(Var, Var); 3] = [
-    (Var::LegLength, Var::BodyLength),
-    (Var::LegLength, Var::Mass),
-    (Var::BodyLength, Var::Mass),
-];
-
-/// A group of robots fitted together: one class, or all fitted robots.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord)]
-pub enum Group {
-    Class(RobotClass),
-    All,
-}
-
-impl Group {
-    /// The paper's Table 2 columns.
-    pub const TABLE2: [Group; 5] = [
-        Group::Class(RobotClass::LowerBiped),
-        Group::Class(RobotClass::FullBiped),
-        Group::Class(RobotClass::Quadruped),
-        Group::Class(RobotClass::Hexapod),
-        Group::All,
-    ];
-    pub fn as_str(self) -> &'static str {
-        match self {
-            Group::Class(c) => c.as_str(),
-            Group::All => "all",
-        }
-    }
-    pub fn label(self) -> &'static str {
-        match self {
-            Group::Class(c) => c.label(),
-            Group::All => "All",
-        }
-    }
-    pub fn parse(s: &str) -> Option<Group> {
-        if s == "all" {
-            Some(Group::All)
-        } else {
-            RobotClass::parse(s)
-                .filter(|c| *c != RobotClass::Hybrid)
-                .map(Group::Class)
-        }
-    }
-    pub fn contains(self, row: &SurveyRow) -> bool {
-        self.includes(row.class, row.fit)
-    }
-    /// Whether a robot of `class`, fitted or not, belongs to the group's fit.
-    pub fn includes(self, class: RobotClass, fit: bool) -> bool {
-        fit && match self {
-            Group::Class(c) => class == c,
-            Group::All => RobotClass::FITTED.contains(&class),
-        }
-    }
-}
-
-impl std::fmt::Display for Group {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.write_str(self.as_str())
-    }
-}
-
-impl Serialize for Group {
-    fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
-        s.serialize_str(self.as_str())
-    }
-}
-
-/// The fitted robots of a group that have both variables, as (id, x, y).
-pub fn points(table: &SurveyTable, group: Group, x: Var, y: Var) -> Vec<(String, f64, f64)> {
-    table
-        .rows
-        .iter()
-        .filter(|r| group.contains(r))
-        .filter_map(|r| Some((r.id.clone(), r.number(x.field())?, r.number(y.field())?)))
-        .collect()
-}
-
-/// The fitted robots of a group with both variables, raw and as log10 (checked once:
-/// a non-positive or non-finite value is an error naming its index).
-#[derive(Debug, Clone)]
-pub struct LogPoints {
-    pub ids: Vec<String>,
-    pub x: Vec<f64>,
-    pub y: Vec<f64>,
-    pub lx: Vec<f64>,
-    pub ly: Vec<f64>,
-}
-
-/// [`points`] with their logarithms.
-pub fn log_points(
-    table: &SurveyTable,
-    group: Group,
-    x: Var,
-    y: Var,
-) -> Result<LogPoints, regression::RegressionError> {
-    let pts = points(table, group, x, y);
-    let (xs, ys): (Vec<f64>, Vec<f64>) = pts.iter().map(|p| (p.1, p.2)).unzip();
-    Ok(LogPoints {
-        lx: regression::log10_checked(&xs, x.as_str())?,
-        ly: regression::log10_checked(&ys, y.as_str())?,
-        ids: pts.into_iter().map(|p| p.0).collect(),
-        x: xs,
-        y: ys,
-    })
-}
+// The variables, groups and points live with the compiled table (the validator selects
+// the same data); re-exported here, where the analyses name them.
+pub use crate::dataset::selection::{Group, LogPoints, TABLE2_PAIRS, Var, log_points, points};
 
 /// Which dataset a result came from.
 #[derive(Debug, Clone, Serialize)]
@@ -334,52 +184,6 @@ pub fn table2_with_bootstrap(
         method,
         fits,
     })
-}
-
-/// A fitted robot far from its class line.
-#[derive(Debug, Clone, Serialize)]
-pub struct Outlier {
-    pub id: String,
-    pub class: Group,
-    pub x: &'static str,
-    pub y: &'static str,
-    pub y_field: &'static str,
-    /// Externally studentized (leave-one-out) residual of the OLS log–log fit.
-    pub t: f64,
-}
-
-/// Fitted robots whose leave-one-out studentized residual exceeds `threshold` in any
-/// Table 2 relation of their class (classes with fewer than 5 robots are skipped).
-pub fn outliers(table: &SurveyTable, threshold: f64) -> Vec<Outlier> {
-    let mut out = Vec::new();
-    for class in RobotClass::FITTED {
-        let g = Group::Class(class);
-        for (x, y) in TABLE2_PAIRS {
-            // Unusable values (non-positive, …) are the other rules' business.
-            let Ok(p) = log_points(table, g, x, y) else {
-                continue;
-            };
-            if p.ids.len() < 5 {
-                continue;
-            }
-            let Ok(d) = regression::ols_diagnostics(&p.lx, &p.ly) else {
-                continue;
-            };
-            for (id, t) in p.ids.iter().zip(d.studentized_external.iter()) {
-                if t.is_finite() && t.abs() > threshold {
-                    out.push(Outlier {
-                        id: id.clone(),
-                        class: g,
-                        x: x.as_str(),
-                        y: y.as_str(),
-                        y_field: y.field(),
-                        t: *t,
-                    });
-                }
-            }
-        }
-    }
-    out
 }
 
 /// How much one robot moves one power law of its class.

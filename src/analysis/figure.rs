@@ -1,0 +1,183 @@
+//! The data of the survey figure (`survey fit --out`: survey.svg, survey.png, survey.html):
+//! for each Table 2 relation, every robot with both values, each class's fitted power law
+//! over its data range and the confidence band of that line. `report/` draws it.
+
+use crate::analysis::table2::{
+    Group, LogPoints, PowerLawRow, TABLE2_PAIRS, Table2, Var, log_points,
+};
+use crate::dataset::{RobotClass, SurveyRow, SurveyTable};
+use crate::regression::{self, Method};
+
+/// One robot in one panel.
+#[derive(Debug, Clone)]
+pub struct FigurePoint {
+    pub id: String,
+    pub name: String,
+    pub class: RobotClass,
+    pub fit: bool,
+    pub exclusion: Option<String>,
+    /// Leg length, body length and mass cells of the compiled table (text as released).
+    pub values: [Option<String>; 3],
+    pub x: f64,
+    pub y: f64,
+}
+
+/// A class's fitted power law in one panel, with the confidence band of the line.
+#[derive(Debug, Clone)]
+pub struct FigureLine {
+    pub class: RobotClass,
+    pub fit: PowerLawRow,
+    /// (x, lower, upper) of the band of the fitted median line (empty for MA and SMA).
+    pub band: Vec<(f64, f64, f64)>,
+    /// Data range of x the line is drawn over.
+    pub x_range: (f64, f64),
+}
+
+/// One log–log panel: a Table 2 relation.
+#[derive(Debug, Clone)]
+pub struct FigurePanel {
+    pub x: Var,
+    pub y: Var,
+    pub points: Vec<FigurePoint>,
+    pub lines: Vec<FigureLine>,
+    /// The fit over all classes (Table 2's last column), listed but not drawn.
+    pub all: Option<PowerLawRow>,
+    /// Robots without both values (or with a value a log axis cannot show): (id, name, why).
+    pub missing: Vec<(String, String, String)>,
+}
+
+/// The data of the figure, computed from the table and its Table 2 fits.
+#[derive(Debug, Clone)]
+pub struct SurveyFigure {
+    pub version: String,
+    pub sha256: String,
+    pub frozen: bool,
+    pub method: Method,
+    pub confidence: f64,
+    pub panels: Vec<FigurePanel>,
+}
+
+fn row_point(r: &SurveyRow, x: Var, y: Var) -> Result<FigurePoint, String> {
+    let get = |v: Var| -> Result<f64, String> {
+        match r.number(v.field()) {
+            None => Err(format!("no {}", v.field())),
+            Some(n) if n <= 0.0 => Err(format!("{} = {n} is not positive", v.field())),
+            Some(n) => Ok(n),
+        }
+    };
+    let (px, py) = (get(x), get(y));
+    let (px, py) = match (px, py) {
+        (Ok(a), Ok(b)) => (a, b),
+        (Err(a), Err(b)) => return Err(format!("{a}, {b}")),
+        (Err(e), _) | (_, Err(e)) => return Err(e),
+    };
+    Ok(FigurePoint {
+        id: r.id.clone(),
+        name: r.name.clone(),
+        class: r.class,
+        fit: r.fit,
+        exclusion: r.exclusion.clone(),
+        values: Var::ALL.map(|v| r.cells.get(v.field()).filter(|s| !s.is_empty()).cloned()),
+        x: px,
+        y: py,
+    })
+}
+
+/// Builds the figure: every row of the table in every panel it has values for, and each
+/// class's Table 2 line with its band (OLS only: the band is the mean interval of the
+/// OLS prediction at each x).
+pub fn survey_figure(table: &SurveyTable, t2: &Table2) -> SurveyFigure {
+    let confidence = t2.fits.first().map(|f| f.confidence).unwrap_or(0.95);
+    let panels = TABLE2_PAIRS
+        .into_iter()
+        .map(|(x, y)| figure_panel(table, t2, x, y, confidence))
+        .collect();
+    SurveyFigure {
+        version: table.version.clone(),
+        sha256: table.sha256.clone(),
+        frozen: table.frozen,
+        method: t2.method,
+        confidence,
+        panels,
+    }
+}
+
+/// One relation: its points (and the robots it cannot show), the class lines and the
+/// all-classes fit.
+fn figure_panel(table: &SurveyTable, t2: &Table2, x: Var, y: Var, confidence: f64) -> FigurePanel {
+    let mut points = Vec::new();
+    let mut missing = Vec::new();
+    for r in &table.rows {
+        match row_point(r, x, y) {
+            Ok(p) => points.push(p),
+            Err(why) => missing.push((r.id.clone(), r.name.clone(), why)),
+        }
+    }
+    let lines = RobotClass::FITTED
+        .into_iter()
+        .filter_map(|c| class_line(table, t2, c, x, y, confidence))
+        .collect();
+    FigurePanel {
+        x,
+        y,
+        all: t2
+            .fits
+            .iter()
+            .find(|f| f.class == Group::All && f.x == x && f.y == y)
+            .cloned(),
+        points,
+        lines,
+        missing,
+    }
+}
+
+/// A class's Table 2 line over its data range, with its band (None without a fit or
+/// without a range to draw).
+fn class_line(
+    table: &SurveyTable,
+    t2: &Table2,
+    c: RobotClass,
+    x: Var,
+    y: Var,
+    confidence: f64,
+) -> Option<FigureLine> {
+    let g = Group::Class(c);
+    let fit = t2
+        .fits
+        .iter()
+        .find(|f| f.class == g && f.x == x && f.y == y)?
+        .clone();
+    let pts = log_points(table, g, x, y).ok()?;
+    let lo = pts.x.iter().copied().fold(f64::INFINITY, f64::min);
+    let hi = pts.x.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+    if !(lo.is_finite() && hi.is_finite() && hi > lo) {
+        return None;
+    }
+    let band = match t2.method {
+        Method::Ols => ols_band(&pts, lo, hi, confidence),
+        _ => Vec::new(),
+    };
+    Some(FigureLine {
+        class: c,
+        fit,
+        band,
+        x_range: (lo, hi),
+    })
+}
+
+/// The confidence band of the OLS line of `pts` at 49 points evenly spaced in log x over
+/// [lo, hi], back-transformed: (x, lower, upper). Empty when the line cannot be fitted.
+fn ols_band(pts: &LogPoints, lo: f64, hi: f64, confidence: f64) -> Vec<(f64, f64, f64)> {
+    let Ok(line) = regression::fit_line(&pts.lx, &pts.ly, Method::Ols, confidence) else {
+        return Vec::new();
+    };
+    let steps = 48;
+    (0..=steps)
+        .filter_map(|i| {
+            let lx = lo.log10() + (hi.log10() - lo.log10()) * i as f64 / steps as f64;
+            let p = regression::predict_ols(&line, lx, confidence).ok()?;
+            let ci = p.mean_ci.map(|v| 10f64.powf(v));
+            Some((10f64.powf(lx), ci.lower, ci.upper))
+        })
+        .collect()
+}
