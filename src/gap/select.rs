@@ -22,7 +22,8 @@ use serde::Serialize;
 
 use super::error::GapError;
 use super::fit::{Consistency, Fit, FitContext, dispersion, lr_p_value};
-use super::knob::KnobKind;
+use super::knob::{KnobKind, Point};
+use super::surrogate::Correction;
 use crate::regression::dist::{chi2_upper_p, normal_quantile};
 
 #[derive(Clone, Debug)]
@@ -35,6 +36,9 @@ pub struct SelectOptions {
     /// Recalibrate every uncertain parameter even when no effect needs the test (for the
     /// report's table); otherwise only when an effect is tested.
     pub always_recalibrate: bool,
+    /// Rounds of the exchange step after the backward pass (`Selector::swap`). 0, the
+    /// default, until the benchmark has measured it: tried on four pair cases only.
+    pub exchange_rounds: usize,
 }
 
 impl Default for SelectOptions {
@@ -44,6 +48,7 @@ impl Default for SelectOptions {
             material_shrink: 0.10,
             max_steps: 4,
             always_recalibrate: true,
+            exchange_rounds: 0,
         }
     }
 }
@@ -131,7 +136,6 @@ pub fn select(
     groupings: &[(String, Vec<usize>)],
     labels: &[String],
 ) -> Result<Selection, GapError> {
-    let n = ctx.n();
     let knobs = &ctx.knobs.list;
     let params: Vec<usize> = (0..knobs.len())
         .filter(|k| knobs[*k].kind == KnobKind::Parameter)
@@ -145,46 +149,169 @@ pub fn select(
             (c, ctx.with_held_out(ctx.screen(&[c], &starts, nominal)))
         })
         .collect();
-    // The recalibration of every uncertain parameter, the baseline of the effect tests: made
-    // when first needed.
-    let mut recalibration: Option<Fit> = None;
-    let mut baseline: Option<Fit> = None;
-    let recalibrated = |recalibration: &mut Option<Fit>| -> Result<Fit, GapError> {
-        if let Some(r) = recalibration {
-            return Ok(r.clone());
-        }
-        (ctx.progress)("recalibrating the nominal parameters");
-        let r = ctx.with_held_out(recalibrate(ctx, nominal, &params, &singles)?);
-        *recalibration = Some(r.clone());
-        Ok(r)
+    let mut sel = Selector {
+        ctx,
+        opts,
+        nominal,
+        groupings,
+        labels,
+        n: ctx.n(),
+        gap0: gap_of(nominal, ctx.n()),
+        params,
+        singles,
+        recalibration: None,
+        baseline: None,
+        notes: Vec::new(),
     };
     let mut current = nominal.clone();
     let mut steps: Vec<Step> = Vec::new();
-    let mut notes = Vec::new();
-    let gap0 = gap_of(nominal, n);
-    for _ in 0..opts.max_steps {
+    let mut swaps_left = opts.exchange_rounds;
+    let mut forward = true;
+    loop {
+        if forward {
+            sel.forward(&mut current, &mut steps)?;
+        }
+        let dropped = sel.eliminate(&mut current)?;
+        steps.retain(|s| !dropped.contains(&s.knob));
+        if current.active.len() < 2 || swaps_left == 0 || !sel.swap(&mut current, &mut steps)? {
+            break;
+        }
+        swaps_left -= 1;
+        // A swap can leave room for a knob the look-alike had blocked.
+        forward = !within_noise(&current, sel.n, opts.alpha) && steps.len() < opts.max_steps;
+    }
+    if opts.always_recalibrate && !sel.params.is_empty() {
+        sel.recalibrated()?;
+    }
+    Ok(Selection {
+        steps,
+        final_fit: current,
+        recalibration: sel.recalibration,
+        notes: sel.notes,
+        singles: sel.singles,
+    })
+}
+
+/// Neighbouring models confirmed with walks per round (the best by the surrogate).
+const SWAP_WALKS: usize = 6;
+
+/// What one forward step found.
+enum Outcome {
+    /// A knob passed every rule: the step, the model with it, and the new baseline of the
+    /// effect tests (the recalibration with the knob added), if it was tested against one.
+    Chosen(Box<(Step, Fit, Option<Fit>)>),
+    /// Nothing passed: every candidate's row, with why.
+    Rejected(Vec<CandidateRow>),
+    /// No candidate left, or no degree of freedom for one.
+    Exhausted,
+}
+
+/// The state of one selection: the context, the singles, the lazily made recalibration and
+/// the baseline the effect tests are made against.
+struct Selector<'s, 'c> {
+    ctx: &'s FitContext<'c>,
+    opts: &'s SelectOptions,
+    nominal: &'s Fit,
+    groupings: &'s [(String, Vec<usize>)],
+    labels: &'s [String],
+    n: usize,
+    gap0: f64,
+    params: Vec<usize>,
+    singles: Vec<(usize, Fit)>,
+    /// The recalibration of every uncertain parameter, the baseline of the effect tests:
+    /// made when first needed.
+    recalibration: Option<Fit>,
+    baseline: Option<Fit>,
+    notes: Vec<String>,
+}
+
+impl Selector<'_, '_> {
+    fn recalibrated(&mut self) -> Result<Fit, GapError> {
+        if let Some(r) = &self.recalibration {
+            return Ok(r.clone());
+        }
+        (self.ctx.progress)("recalibrating the nominal parameters");
+        let r = self.ctx.with_held_out(recalibrate(
+            self.ctx,
+            self.nominal,
+            &self.params,
+            &self.singles,
+        )?);
+        self.recalibration = Some(r.clone());
+        Ok(r)
+    }
+
+    /// The likelihood-ratio test of `f` against `base`: (LR, over-dispersion of `f`, p).
+    fn test(&self, f: &Fit, base: &Fit) -> (f64, f64, f64) {
+        let lr = base.chi2 - f.chi2;
+        let phi = dispersion(f.chi2_data, self.n, f.k());
+        (
+            lr,
+            phi,
+            lr_p_value(lr, 1, phi, self.n.saturating_sub(f.k())),
+        )
+    }
+
+    /// Forward steps from `current` until nothing passes or the step limit.
+    fn forward(&mut self, current: &mut Fit, steps: &mut Vec<Step>) -> Result<(), GapError> {
+        while steps.len() < self.opts.max_steps {
+            match self.step(current, steps.len())? {
+                Outcome::Chosen(chosen) => {
+                    let (step, real, nb) = *chosen;
+                    steps.push(step);
+                    *current = real;
+                    if let Some(nb) = nb {
+                        self.baseline = Some(nb);
+                    }
+                }
+                Outcome::Rejected(rows) => {
+                    // Nothing passes: the last step's table is the record of why.
+                    if let Some(last) = steps.last_mut() {
+                        last.candidates
+                            .retain(|r| !r.verdict.starts_with("next step: "));
+                        last.candidates.extend(rows.into_iter().map(|mut r| {
+                            r.verdict = format!("next step: {}", r.verdict);
+                            r
+                        }));
+                    } else {
+                        steps_rejected(&mut self.notes, rows);
+                    }
+                    break;
+                }
+                Outcome::Exhausted => break,
+            }
+        }
+        Ok(())
+    }
+
+    /// One forward step: every knob not in `current` fitted with it, the best by held-out
+    /// χ² that passes every rule is chosen.
+    fn step(&mut self, current: &Fit, taken: usize) -> Result<Outcome, GapError> {
+        let ctx = self.ctx;
+        let n = self.n;
+        let knobs = &ctx.knobs.list;
         let cands: Vec<usize> = (0..knobs.len())
             .filter(|k| !current.active.contains(k))
             .collect();
         if cands.is_empty() || n <= current.k() + 1 {
-            break;
+            return Ok(Outcome::Exhausted);
         }
-        let alpha_step = opts.alpha / cands.len() as f64;
+        let alpha_step = self.opts.alpha / cands.len() as f64;
         (ctx.progress)(&format!(
             "step {}: fitting {} candidates",
-            steps.len() + 1,
+            taken + 1,
             cands.len()
         ));
         let mut screened: Vec<(usize, Fit)> = if current.active.is_empty() {
-            singles.clone()
+            self.singles.clone()
         } else {
             cands
                 .iter()
                 .map(|&c| {
                     let mut active = current.active.clone();
                     active.push(c);
-                    let starts = ctx.starts_adding(&current, c);
-                    let f = ctx.screen(&active, &starts, &current);
+                    let starts = ctx.starts_adding(current, c);
+                    let f = ctx.screen(&active, &starts, current);
                     (c, ctx.with_held_out(f))
                 })
                 .collect()
@@ -195,14 +322,12 @@ pub fn select(
                 .total_cmp(&b.1.held_out.unwrap_or(f64::INFINITY))
         });
         let mut rows: Vec<CandidateRow> = Vec::new();
-        let mut chosen: Option<Step> = None;
-        let mut next: Option<(Fit, Option<Fit>)> = None;
+        let mut chosen: Option<(Step, Fit, Option<Fit>)> = None;
         let mut attempts = 0;
         // Candidates confirmed with walks at this step (for the ambiguity check).
         let mut walked: Vec<(usize, Fit)> = Vec::new();
         for (c, f) in &screened {
             let knob = &knobs[*c];
-            let pos = f.active.len() - 1;
             let row = |verdict: String, f: &Fit, lr: f64, p: f64| CandidateRow {
                 knob: knob.label(),
                 kind: knob.kind,
@@ -212,12 +337,7 @@ pub fn select(
                 p_value: p,
                 verdict,
             };
-            let test = |f: &Fit, base: &Fit| -> (f64, f64, f64) {
-                let lr = base.chi2 - f.chi2;
-                let phi = dispersion(f.chi2_data, n, f.k());
-                (lr, phi, lr_p_value(lr, 1, phi, n.saturating_sub(f.k())))
-            };
-            let (lr, _, p) = test(f, &current);
+            let (lr, _, p) = self.test(f, current);
             if chosen.is_some() || attempts >= 3 {
                 rows.push(row("not tried (another was chosen first)".into(), f, lr, p));
                 continue;
@@ -237,166 +357,126 @@ pub fn select(
             }
             attempts += 1;
             (ctx.progress)(&format!("confirming {} with walks", knob.label()));
-            let starts = ctx.starts_adding(&current, *c);
+            let starts = ctx.starts_adding(current, *c);
             let real =
-                ctx.with_held_out(ctx.fit_walked(&f.active, &starts, Some(f), Some(&current))?);
+                ctx.with_held_out(ctx.fit_walked(&f.active, &starts, Some(f), Some(current))?);
             walked.push((*c, real.clone()));
-            let (lr_r, phi_r, p_r) = test(&real, &current);
-            let t = real.unit[pos];
-            if p_r >= alpha_step {
-                rows.push(row(
-                    format!("not significant once walked (p = {p_r:.1e} ≥ {alpha_step:.1e})"),
-                    &real,
-                    lr_r,
-                    p_r,
-                ));
-                continue;
-            }
-            let gap_before = gap_of(&current, n);
-            let gap_after = gap_of(&real, n);
-            let noise_after = within_noise(&real, n, opts.alpha);
-            if gap_after >= gap_before {
-                rows.push(row(
-                    "no better on held-out conditions once walked".into(),
-                    &real,
-                    lr_r,
-                    p_r,
-                ));
-                continue;
-            }
-            if (1.0 - gap_after / gap_before) < opts.material_shrink && !noise_after {
-                rows.push(row(
-                    format!(
-                        "not material: the held-out gap shrinks by {:.0} % (< {:.0} %) and the rest stays beyond noise",
-                        100.0 * (1.0 - gap_after / gap_before),
-                        100.0 * opts.material_shrink
-                    ),
-                    &real,
-                    lr_r,
-                    p_r,
-                ));
-                continue;
-            }
-            if !(0.01..=0.99).contains(&t) {
-                let why = format!(
-                    "fitted at the {} end of its plausible range ({:.3e} {}): the trials want more than the range allows",
-                    if t < 0.5 { "lower" } else { "upper" },
-                    real.point[*c].map(|x| knob.si(x)).unwrap_or(f64::NAN),
-                    knob.unit
-                );
-                notes.push(format!("{}: {why}; not called", knob.label()));
-                rows.push(row(why, &real, lr_r, p_r));
-                continue;
-            }
-            let mut p_recal = None;
-            let mut new_baseline = None;
-            if knob.kind == KnobKind::Effect && !params.is_empty() {
-                if baseline.is_none() {
-                    baseline = Some(recalibrated(&mut recalibration)?);
+            match self.judge(current, *c, &real, alpha_step, &screened, &walked)? {
+                Err(why) => {
+                    let (lr_r, _, p_r) = self.test(&real, current);
+                    rows.push(row(why, &real, lr_r, p_r));
                 }
-                let Some(base) = baseline.as_ref() else {
-                    continue;
-                };
-                (ctx.progress)(&format!(
-                    "testing {} against the recalibration",
-                    knob.label()
-                ));
-                let starts = ctx.starts_adding(base, *c);
-                let mut active = base.active.clone();
-                active.push(*c);
-                let nf = ctx.fit_walked(&active, &starts, None, Some(base))?;
-                let (lr_n, _, p_n) = test(&nf, base);
-                p_recal = Some(p_n);
-                if p_n >= alpha_step {
-                    rows.push(row(
-                        format!(
-                            "does not beat the recalibrated nominal (LR {lr_n:.1}, p = {p_n:.1e}): \
-                             a plausible error of the uncertain parameters explains it as well"
-                        ),
-                        &real,
-                        lr_r,
-                        p_r,
-                    ));
-                    continue;
-                }
-                new_baseline = Some(nf);
-            }
-            let het = ctx.consistency(&real, &current, groupings, labels, phi_r);
-            if let Some(h) = het.iter().find(|h| !h.consistent) {
-                let why = format!(
-                    "not one value for all conditions: it makes the {} group of {} worse than \
-                     without it (χ² +{:.1}, allowed {:.1})",
-                    h.worst_group, h.by, h.worst_rise, h.allowed
-                );
-                notes.push(format!("{}: {why}; not called", knob.label()));
-                rows.push(row(why, &real, lr_r, p_r));
-                continue;
-            }
-            // Ambiguity: another significant candidate (of either kind, including an effect
-            // the recalibration explains as well) fits within the identification distance
-            // of this one, confirmed with walks. The step then explains the gap but names
-            // nothing: "one of these".
-            let margin = separable_margin() * phi_r;
-            let mut not_separable: Vec<String> = walked
-                .iter()
-                .filter(|(o, of)| {
-                    o != c && test(of, &current).2 < alpha_step && of.chi2 - real.chi2 < margin
-                })
-                .map(|(o, _)| knobs[*o].label())
-                .collect();
-            let mut close: Vec<&(usize, Fit)> = screened
-                .iter()
-                .filter(|(o, of)| {
-                    o != c
-                        && !walked.iter().any(|(w, _)| w == o)
-                        && test(of, &current).2 < alpha_step
-                        && of.chi2 - real.chi2 < 2.0 * margin
-                })
-                .collect();
-            close.sort_by(|a, b| a.1.chi2.total_cmp(&b.1.chi2));
-            for (o, of) in close.into_iter().take(2) {
-                (ctx.progress)(&format!(
-                    "is {} separable from {}?",
-                    knob.label(),
-                    knobs[*o].label()
-                ));
-                let starts = ctx.starts_adding(&current, *o);
-                let of_real = ctx.fit_walked(&of.active, &starts, Some(of), Some(&current))?;
-                if test(&of_real, &current).2 < alpha_step && of_real.chi2 - real.chi2 < margin {
-                    not_separable.push(knobs[*o].label());
+                Ok((step, new_baseline)) => {
+                    let (lr_r, _, p_r) = self.test(&real, current);
+                    rows.push(row("chosen".into(), &real, lr_r, p_r));
+                    chosen = Some((step, real, new_baseline));
                 }
             }
-            // A close candidate that still explains something once this one is in the model
-            // is a second cause (a complement), not a rival: with two causes present, each
-            // alone explains a similar share of the gap.
-            let mut rivals = Vec::new();
-            for label in not_separable {
-                let Some(o) = ctx.knobs.index_of(&label) else {
-                    continue;
-                };
-                let mut both_active = real.active.clone();
-                both_active.push(o);
-                let starts = ctx.starts_adding(&real, o);
-                let both = ctx.fit_walked(&both_active, &starts, None, Some(&real))?;
-                let (_, _, p_both) = test(&both, &real);
-                if p_both >= alpha_step {
-                    rivals.push(label);
-                }
+        }
+        Ok(match chosen {
+            Some((mut step, real, nb)) => {
+                step.candidates = rows;
+                Outcome::Chosen(Box::new((step, real, nb)))
             }
-            let not_separable = rivals;
-            rows.push(row("chosen".into(), &real, lr_r, p_r));
-            chosen = Some(Step {
+            None => Outcome::Rejected(rows),
+        })
+    }
+
+    /// The rules for knob `c`, walked into `real` from `current`: the step it makes, with
+    /// the new baseline of the effect tests, or why it is not taken.
+    fn judge(
+        &mut self,
+        current: &Fit,
+        c: usize,
+        real: &Fit,
+        alpha_step: f64,
+        screened: &[(usize, Fit)],
+        walked: &[(usize, Fit)],
+    ) -> Result<Result<(Step, Option<Fit>), String>, GapError> {
+        let ctx = self.ctx;
+        let n = self.n;
+        let knob = &ctx.knobs.list[c];
+        let pos = real.active.len() - 1;
+        let (lr_r, phi_r, p_r) = self.test(real, current);
+        let t = real.unit[pos];
+        if p_r >= alpha_step {
+            return Ok(Err(format!(
+                "not significant once walked (p = {p_r:.1e} ≥ {alpha_step:.1e})"
+            )));
+        }
+        let gap_before = gap_of(current, n);
+        let gap_after = gap_of(real, n);
+        let noise_after = within_noise(real, n, self.opts.alpha);
+        if gap_after >= gap_before {
+            return Ok(Err("no better on held-out conditions once walked".into()));
+        }
+        if (1.0 - gap_after / gap_before) < self.opts.material_shrink && !noise_after {
+            return Ok(Err(format!(
+                "not material: the held-out gap shrinks by {:.0} % (< {:.0} %) and the rest stays beyond noise",
+                100.0 * (1.0 - gap_after / gap_before),
+                100.0 * self.opts.material_shrink
+            )));
+        }
+        if !(0.01..=0.99).contains(&t) {
+            let why = format!(
+                "fitted at the {} end of its plausible range ({:.3e} {}): the trials want more than the range allows",
+                if t < 0.5 { "lower" } else { "upper" },
+                real.point[c].map(|x| knob.si(x)).unwrap_or(f64::NAN),
+                knob.unit
+            );
+            self.notes
+                .push(format!("{}: {why}; not called", knob.label()));
+            return Ok(Err(why));
+        }
+        let mut p_recal = None;
+        let mut new_baseline = None;
+        if knob.kind == KnobKind::Effect && !self.params.is_empty() {
+            if self.baseline.is_none() {
+                self.baseline = Some(self.recalibrated()?);
+            }
+            let Some(base) = self.baseline.as_ref() else {
+                return Ok(Err("no recalibration to test against".into()));
+            };
+            (ctx.progress)(&format!(
+                "testing {} against the recalibration",
+                knob.label()
+            ));
+            let starts = ctx.starts_adding(base, c);
+            let mut active = base.active.clone();
+            active.push(c);
+            let nf = ctx.fit_walked(&active, &starts, None, Some(base))?;
+            let (lr_n, _, p_n) = self.test(&nf, base);
+            p_recal = Some(p_n);
+            if p_n >= alpha_step {
+                return Ok(Err(format!(
+                    "does not beat the recalibrated nominal (LR {lr_n:.1}, p = {p_n:.1e}): \
+                     a plausible error of the uncertain parameters explains it as well"
+                )));
+            }
+            new_baseline = Some(nf);
+        }
+        let het = ctx.consistency(real, current, self.groupings, self.labels, phi_r);
+        if let Some(h) = het.iter().find(|h| !h.consistent) {
+            let why = format!(
+                "not one value for all conditions: it makes the {} group of {} worse than \
+                 without it (χ² +{:.1}, allowed {:.1})",
+                h.worst_group, h.by, h.worst_rise, h.allowed
+            );
+            self.notes
+                .push(format!("{}: {why}; not called", knob.label()));
+            return Ok(Err(why));
+        }
+        let not_separable =
+            self.rivals_at_step(current, c, real, phi_r, alpha_step, screened, walked)?;
+        Ok(Ok((
+            Step {
                 knob: knob.label(),
                 kind: knob.kind,
-                value_si: real.point[*c].map(|x| knob.si(x)).unwrap_or(f64::NAN),
-                values_si: real
-                    .active
-                    .iter()
-                    .filter_map(|k| real.point[*k].map(|x| (knobs[*k].label(), knobs[*k].si(x))))
-                    .collect(),
+                value_si: real.point[c].map(|x| knob.si(x)).unwrap_or(f64::NAN),
+                values_si: self.values_si(real),
                 gap_after,
                 shrink_pct: 100.0 * (1.0 - gap_after / gap_before),
-                shrink_total_pct: 100.0 * (1.0 - gap_after / gap0),
+                shrink_total_pct: 100.0 * (1.0 - gap_after / self.gap0),
                 lr: lr_r,
                 dispersion: phi_r,
                 p_value: p_r,
@@ -405,79 +485,426 @@ pub fn select(
                 within_noise_after: noise_after,
                 not_separable_from: not_separable,
                 candidates: Vec::new(),
-            });
-            next = Some((real, new_baseline));
-        }
-        match (chosen, next) {
-            (Some(mut step), Some((real, nb))) => {
-                step.candidates = rows;
-                steps.push(step);
-                current = real;
-                if let Some(nb) = nb {
-                    baseline = Some(nb);
-                }
+            },
+            new_baseline,
+        )))
+    }
+
+    /// Every free knob's value in SI.
+    fn values_si(&self, fit: &Fit) -> Vec<(String, f64)> {
+        let knobs = &self.ctx.knobs.list;
+        fit.active
+            .iter()
+            .filter_map(|k| fit.point[*k].map(|x| (knobs[*k].label(), knobs[*k].si(x))))
+            .collect()
+    }
+
+    /// Ambiguity at a step: another significant candidate (of either kind, including an
+    /// effect the recalibration explains as well) fits within the identification distance
+    /// of knob `c`, confirmed with walks. The step then explains the gap but names nothing:
+    /// "one of these".
+    #[allow(clippy::too_many_arguments)]
+    fn rivals_at_step(
+        &self,
+        current: &Fit,
+        c: usize,
+        real: &Fit,
+        phi_r: f64,
+        alpha_step: f64,
+        screened: &[(usize, Fit)],
+        walked: &[(usize, Fit)],
+    ) -> Result<Vec<String>, GapError> {
+        let ctx = self.ctx;
+        let knobs = &ctx.knobs.list;
+        let knob = &knobs[c];
+        let margin = separable_margin() * phi_r;
+        let mut not_separable: Vec<String> = walked
+            .iter()
+            .filter(|(o, of)| {
+                *o != c && self.test(of, current).2 < alpha_step && of.chi2 - real.chi2 < margin
+            })
+            .map(|(o, _)| knobs[*o].label())
+            .collect();
+        let mut close: Vec<&(usize, Fit)> = screened
+            .iter()
+            .filter(|(o, of)| {
+                *o != c
+                    && !walked.iter().any(|(w, _)| w == o)
+                    && self.test(of, current).2 < alpha_step
+                    && of.chi2 - real.chi2 < 2.0 * margin
+            })
+            .collect();
+        close.sort_by(|a, b| a.1.chi2.total_cmp(&b.1.chi2));
+        for (o, of) in close.into_iter().take(2) {
+            (ctx.progress)(&format!(
+                "is {} separable from {}?",
+                knob.label(),
+                knobs[*o].label()
+            ));
+            let starts = ctx.starts_adding(current, *o);
+            let of_real = ctx.fit_walked(&of.active, &starts, Some(of), Some(current))?;
+            if self.test(&of_real, current).2 < alpha_step && of_real.chi2 - real.chi2 < margin {
+                not_separable.push(knobs[*o].label());
             }
-            _ => {
-                // Nothing passes: the last step's table is the record of why.
-                if let Some(last) = steps.last_mut() {
-                    last.candidates.extend(rows.into_iter().map(|mut r| {
-                        r.verdict = format!("next step: {}", r.verdict);
-                        r
-                    }));
-                } else {
-                    steps_rejected(&mut notes, rows);
-                }
+        }
+        self.complements_removed(real, not_separable, alpha_step)
+    }
+
+    /// A close candidate that still explains something once the chosen one is in the model
+    /// is a second cause (a complement), not a rival: with two causes present, each alone
+    /// explains a similar share of the gap.
+    fn complements_removed(
+        &self,
+        real: &Fit,
+        candidates: Vec<String>,
+        alpha: f64,
+    ) -> Result<Vec<String>, GapError> {
+        let ctx = self.ctx;
+        let mut rivals = Vec::new();
+        for label in candidates {
+            let Some(o) = ctx.knobs.index_of(&label) else {
+                continue;
+            };
+            let mut both_active = real.active.clone();
+            both_active.push(o);
+            let starts = ctx.starts_adding(real, o);
+            let both = ctx.fit_walked(&both_active, &starts, None, Some(real))?;
+            let (_, _, p_both) = self.test(&both, real);
+            if p_both >= alpha {
+                rivals.push(label);
+            }
+        }
+        Ok(rivals)
+    }
+
+    /// Backward elimination: a knob picked early, on a model still far from the data, may
+    /// be redundant once later knobs are in (it mimicked part of their signature). Each knob
+    /// of the final model must still be significant given all the others. Returns the
+    /// dropped knobs' labels.
+    fn eliminate(&mut self, current: &mut Fit) -> Result<Vec<String>, GapError> {
+        let ctx = self.ctx;
+        let knobs = &ctx.knobs.list;
+        let n = self.n;
+        let mut dropped = Vec::new();
+        loop {
+            if current.active.len() < 2 {
                 break;
             }
-        }
-    }
-    // Backward elimination: a knob picked early, on a model still far from the data, may be
-    // redundant once later knobs are in (it mimicked part of their signature). Each knob of
-    // the final model must still be significant given all the others.
-    let mut dropped = Vec::new();
-    loop {
-        if current.active.len() < 2 {
-            break;
-        }
-        let alpha_drop = opts.alpha / knobs.len().max(1) as f64;
-        let mut weakest: Option<(usize, f64, Fit)> = None;
-        for &k in &current.active {
-            let rest: Vec<usize> = current.active.iter().copied().filter(|x| *x != k).collect();
-            let mut start = current.point.clone();
-            start[k] = None;
-            let starts = vec![(start, current.correction.clone())];
-            let reduced = ctx.fit_walked(&rest, &starts, None, None)?;
-            let lr = reduced.chi2 - current.chi2;
-            let phi = dispersion(current.chi2_data, n, current.k());
-            let p = lr_p_value(lr, 1, phi, n.saturating_sub(current.k()));
-            if weakest.as_ref().is_none_or(|(_, wp, _)| p > *wp) {
-                weakest = Some((k, p, reduced));
+            let alpha_drop = self.opts.alpha / knobs.len().max(1) as f64;
+            let mut weakest: Option<(usize, f64, Fit)> = None;
+            for &k in &current.active {
+                let rest: Vec<usize> = current.active.iter().copied().filter(|x| *x != k).collect();
+                let mut start = current.point.clone();
+                start[k] = None;
+                let starts = vec![(start, current.correction.clone())];
+                let reduced = ctx.fit_walked(&rest, &starts, None, None)?;
+                let lr = reduced.chi2 - current.chi2;
+                let phi = dispersion(current.chi2_data, n, current.k());
+                let p = lr_p_value(lr, 1, phi, n.saturating_sub(current.k()));
+                if weakest.as_ref().is_none_or(|(_, wp, _)| p > *wp) {
+                    weakest = Some((k, p, reduced));
+                }
+            }
+            match weakest {
+                Some((k, p, reduced)) if p >= alpha_drop => {
+                    let label = knobs[k].label();
+                    self.notes.push(format!(
+                        "{label} dropped from the answer: once the other knobs are in, it is no \
+                         longer significant (p = {p:.1e}); it had mimicked part of their signature"
+                    ));
+                    dropped.push(label);
+                    *current = ctx.with_held_out(reduced);
+                }
+                _ => break,
             }
         }
-        match weakest {
-            Some((k, p, reduced)) if p >= alpha_drop => {
-                let label = knobs[k].label();
-                notes.push(format!(
-                    "{label} dropped from the answer: once the other knobs are in, it is no longer \
-                     significant (p = {p:.1e}); it had mimicked part of their signature"
-                ));
-                dropped.push(label);
-                current = ctx.with_held_out(reduced);
+        Ok(dropped)
+    }
+
+    /// Exchanges. Forward selection is greedy: the knob taken first because it explains
+    /// most of the gap alone can be a look-alike of one of two true causes (hip Coulomb
+    /// friction standing in for viscous damping, latency for backlash), and once it is in,
+    /// the true cause no longer passes. So the final model is compared with its neighbours
+    /// of the same size: with two knobs, every other pair of knobs (best subset of size two);
+    /// with more, every model with one knob exchanged. All are screened on the surrogate and
+    /// the best few confirmed with walks. One that fits better by more than the
+    /// identification distance, on held-out conditions too, replaces the model — if its
+    /// knobs also form a chain every forward rule accepts (significance, materiality, range,
+    /// recalibration, consistency), rebuilt from the nominal (returns true). Otherwise a
+    /// neighbour within that distance is a look-alike these trials cannot tell from the
+    /// model: the knobs it exchanges are ambiguous, and none of them is named.
+    fn swap(&mut self, current: &mut Fit, steps: &mut Vec<Step>) -> Result<bool, GapError> {
+        let ctx = self.ctx;
+        let knobs = &ctx.knobs.list;
+        let n = self.n;
+        (ctx.progress)("comparing the model with its neighbours (knobs exchanged)");
+        let phi = dispersion(current.chi2_data, n, current.k());
+        let phi = if phi.is_finite() { phi } else { 1.0 };
+        let margin = separable_margin() * phi;
+        let nominal = self.nominal;
+        let mut sorted_current = current.active.clone();
+        sorted_current.sort_unstable();
+        // The neighbours, each as its knob set.
+        let mut neighbours: Vec<Vec<usize>> = Vec::new();
+        if current.k() == 2 {
+            for a in 0..knobs.len() {
+                for b in a + 1..knobs.len() {
+                    if [a, b] != sorted_current[..] {
+                        neighbours.push(vec![a, b]);
+                    }
+                }
             }
-            _ => break,
+        } else {
+            for &k in &current.active {
+                for c in (0..knobs.len()).filter(|c| !current.active.contains(c)) {
+                    let mut set: Vec<usize> =
+                        current.active.iter().copied().filter(|x| *x != k).collect();
+                    set.push(c);
+                    neighbours.push(set);
+                }
+            }
         }
+        // Screened with the surrogate correction measured at the current model (the
+        // surrogate's bias near the answer), the current model the same way.
+        let single_point = |k: usize| {
+            self.singles
+                .iter()
+                .find(|(c, _)| *c == k)
+                .and_then(|(_, f)| f.point[k])
+        };
+        let starts_for = |set: &[usize], from: &Fit| -> Vec<(Point, Correction)> {
+            // Knobs outside the set at their nominal (an effect off), those in it at the
+            // current model's value or, new, at their single optimum.
+            let mut p = nominal.point.clone();
+            for &k in set {
+                p[k] = from.point[k].or_else(|| single_point(k));
+            }
+            let mut starts = vec![(p, from.correction.clone())];
+            // The last knob scanned with the others at their single optima.
+            let mut base = from.clone();
+            base.active = set[..set.len() - 1].to_vec();
+            base.point = nominal.point.clone();
+            for &k in &base.active {
+                base.point[k] = from.point[k].or_else(|| single_point(k));
+            }
+            starts.extend(ctx.starts_adding(&base, set[set.len() - 1]));
+            starts
+        };
+        let own = ctx.screen(
+            &current.active,
+            &[(current.point.clone(), current.correction.clone())],
+            current,
+        );
+        let mut screened: Vec<(Vec<usize>, Fit)> = neighbours
+            .into_iter()
+            .map(|set| {
+                let starts = starts_for(&set, current);
+                let f = ctx.screen(&set, &starts, current);
+                (set, f)
+            })
+            .filter(|(_, f)| f.chi2 < own.chi2 + 2.0 * margin)
+            .collect();
+        screened.sort_by(|a, b| a.1.chi2.total_cmp(&b.1.chi2));
+        let mut walked: Vec<(Vec<usize>, Fit)> = Vec::new();
+        for (set, f) in screened.into_iter().take(SWAP_WALKS) {
+            let names: Vec<String> = set.iter().map(|k| knobs[*k].label()).collect();
+            (ctx.progress)(&format!("neighbour {}", names.join(" + ")));
+            let starts = starts_for(&set, current);
+            let real = ctx.with_held_out(ctx.fit_walked(&set, &starts, Some(&f), None)?);
+            walked.push((set, real));
+        }
+        walked.sort_by(|a, b| a.1.chi2.total_cmp(&b.1.chi2));
+        let label_set = |set: &[usize]| -> String {
+            set.iter()
+                .map(|k| knobs[*k].label())
+                .collect::<Vec<_>>()
+                .join(" + ")
+        };
+        for (set, real) in &walked {
+            let in_range = real.unit.iter().all(|t| (0.01..=0.99).contains(t));
+            let better = real.chi2 < current.chi2 - margin
+                && real.held_out.unwrap_or(f64::INFINITY)
+                    < current.held_out.unwrap_or(f64::INFINITY)
+                && in_range;
+            if !better {
+                continue;
+            }
+            let (chain, fit) = match self.rebuild_chain(set)? {
+                Ok(built) => built,
+                Err(why) => {
+                    self.notes.push(format!(
+                        "{} fits better than {} (χ² {:.1} vs {:.1}) but its knobs do not form a \
+                         chain every rule accepts ({why}): not taken",
+                        label_set(set),
+                        label_set(&current.active),
+                        real.chi2,
+                        current.chi2
+                    ));
+                    continue;
+                }
+            };
+            // The walked neighbour and the chain's last model have the same knobs; the
+            // better optimum of the two is the answer's model.
+            let fit = if real.chi2 < fit.chi2 {
+                real.clone()
+            } else {
+                fit
+            };
+            self.notes.push(format!(
+                "{} replaced {} (χ² {:.1} → {:.1}): forward selection had taken a look-alike \
+                 first; the chain below is rebuilt from the nominal in the new model's order",
+                label_set(set),
+                label_set(&current.active),
+                current.chi2,
+                fit.chi2
+            ));
+            *steps = chain;
+            if let Some(last) = steps.last_mut() {
+                let gap_after = gap_of(&fit, n);
+                last.values_si = self.values_si(&fit);
+                last.gap_after = gap_after;
+                last.shrink_total_pct = 100.0 * (1.0 - gap_after / self.gap0);
+                last.within_noise_after = within_noise(&fit, n, self.opts.alpha);
+            }
+            *current = fit;
+            return Ok(true);
+        }
+        self.mark_look_alikes(current, steps, &walked, margin)?;
+        Ok(false)
     }
-    steps.retain(|s| !dropped.contains(&s.knob));
-    if opts.always_recalibrate && !params.is_empty() {
-        recalibrated(&mut recalibration)?;
+
+    /// No neighbour is better: those within the identification distance `margin` are
+    /// look-alikes of the knobs they exchange, unless their new knobs are further causes
+    /// (complements: significant once added to the model). The exchanged knobs' steps get
+    /// them as rivals (ambiguous: none named).
+    fn mark_look_alikes(
+        &mut self,
+        current: &Fit,
+        steps: &mut [Step],
+        walked: &[(Vec<usize>, Fit)],
+        margin: f64,
+    ) -> Result<(), GapError> {
+        let knobs = &self.ctx.knobs.list;
+        let label_set = |set: &[usize]| -> String {
+            set.iter()
+                .map(|k| knobs[*k].label())
+                .collect::<Vec<_>>()
+                .join(" + ")
+        };
+        let alpha = self.opts.alpha / knobs.len().max(1) as f64;
+        for (set, real) in walked {
+            if real.chi2 - current.chi2 >= margin {
+                continue;
+            }
+            let new: Vec<String> = set
+                .iter()
+                .filter(|k| !current.active.contains(k))
+                .map(|k| knobs[*k].label())
+                .collect();
+            let rivals = self.complements_removed(current, new, alpha)?;
+            if rivals.is_empty() {
+                continue;
+            }
+            let out: Vec<String> = current
+                .active
+                .iter()
+                .filter(|k| !set.contains(k))
+                .map(|k| knobs[*k].label())
+                .collect();
+            self.notes.push(format!(
+                "{} and {} fit these trials alike (χ² {:.1} vs {:.1}, identification distance \
+                 {margin:.1}): {} not named",
+                label_set(&current.active),
+                label_set(set),
+                current.chi2,
+                real.chi2,
+                out.join(", ")
+            ));
+            for step in steps.iter_mut().filter(|s| out.contains(&s.knob)) {
+                for r in &rivals {
+                    if !step.not_separable_from.contains(r) {
+                        step.not_separable_from.push(r.clone());
+                    }
+                }
+            }
+        }
+        Ok(())
     }
-    Ok(Selection {
-        steps,
-        final_fit: current,
-        recalibration,
-        notes,
-        singles,
-    })
+
+    /// The chain of forward steps through exactly the knobs `set`, from the nominal, every
+    /// step judged by the forward rules (in the order of their single fits, then, for two
+    /// knobs, the other order). When no order passes, why each failed; notes and the effect
+    /// baseline are then as before.
+    fn rebuild_chain(
+        &mut self,
+        set: &[usize],
+    ) -> Result<Result<(Vec<Step>, Fit), String>, GapError> {
+        let ctx = self.ctx;
+        let knobs = &ctx.knobs.list;
+        let saved_notes = self.notes.len();
+        let saved_baseline = self.baseline.clone();
+        let chi2_alone = |k: usize| {
+            self.singles
+                .iter()
+                .find(|(c, _)| *c == k)
+                .map_or(f64::INFINITY, |(_, f)| f.chi2)
+        };
+        let mut order = set.to_vec();
+        order.sort_by(|a, b| chi2_alone(*a).total_cmp(&chi2_alone(*b)));
+        let mut orders = vec![order.clone()];
+        if order.len() == 2 {
+            orders.push(vec![order[1], order[0]]);
+        }
+        let mut whys = Vec::new();
+        for order in orders {
+            self.baseline = None;
+            let mut current = self.nominal.clone();
+            let mut chain = Vec::new();
+            let mut passed = true;
+            for &c in &order {
+                let left = knobs.len().saturating_sub(current.k()).max(1);
+                let alpha_step = self.opts.alpha / left as f64;
+                let mut active = current.active.clone();
+                active.push(c);
+                let starts = ctx.starts_adding(&current, c);
+                let f = ctx.screen(&active, &starts, &current);
+                let real = ctx.with_held_out(ctx.fit_walked(
+                    &active,
+                    &starts,
+                    Some(&f),
+                    Some(&current),
+                )?);
+                match self.judge(&current, c, &real, alpha_step, &[], &[])? {
+                    Ok((step, nb)) => {
+                        chain.push(step);
+                        current = real;
+                        if let Some(nb) = nb {
+                            self.baseline = Some(nb);
+                        }
+                    }
+                    Err(why) => {
+                        whys.push(format!("{} after {}: {why}", knobs[c].label(), {
+                            let before: Vec<String> =
+                                current.active.iter().map(|k| knobs[*k].label()).collect();
+                            if before.is_empty() {
+                                "the nominal".to_string()
+                            } else {
+                                before.join(" + ")
+                            }
+                        }));
+                        passed = false;
+                        break;
+                    }
+                }
+            }
+            if passed {
+                return Ok(Ok((chain, current)));
+            }
+            self.notes.truncate(saved_notes);
+        }
+        self.baseline = saved_baseline;
+        Ok(Err(whys.join("; ")))
+    }
 }
 
 /// The best recalibration of every uncertain parameter: Nelder–Mead on the surrogate from
