@@ -649,7 +649,7 @@ fn gap_synth_csv(
             )?),
         };
         let out = gap::synth::synthesize(&lib, &opts, conditions, &command, &|| {})?;
-        Ok(out.to_csv())
+        Ok(out.to_csv()?)
     })
 }
 

@@ -364,7 +364,7 @@ fn synth(a: &SynthArgs) -> anyhow::Result<ExitCode> {
     let Some(dir) = &a.logs else {
         let set = gap::synth::synthesize(&lib, &opts, conditions, &command, &|| pb.inc(1))?;
         pb.finish_and_clear();
-        write_atomic(&a.out, set.to_csv().as_bytes())?;
+        write_atomic(&a.out, set.to_csv()?.as_bytes())?;
         eprintln!("wrote {} ({} trials)", a.out.display(), set.trials.len());
         return Ok(ExitCode::SUCCESS);
     };
@@ -410,7 +410,7 @@ fn synth(a: &SynthArgs) -> anyhow::Result<ExitCode> {
         )?;
         t.trajectory = Some(rel_dir.join(&name).to_string_lossy().replace('\\', "/"));
     }
-    write_atomic(&a.out, set.to_csv().as_bytes())?;
+    write_atomic(&a.out, set.to_csv()?.as_bytes())?;
     eprintln!(
         "wrote {} ({} trials) and {} logs in {}",
         a.out.display(),
@@ -502,7 +502,7 @@ fn suggest(a: &SuggestArgs) -> anyhow::Result<ExitCode> {
             base_dir: PathBuf::from("."),
             trials: gap::suggest::as_trials(&s),
         };
-        write_atomic(p, next.to_csv().as_bytes())?;
+        write_atomic(p, next.to_csv()?.as_bytes())?;
         eprintln!(
             "wrote {} ({} conditions to run)",
             p.display(),

@@ -245,32 +245,19 @@ impl TrialSet {
     }
 
     /// The trials as CSV, in the format [`TrialSet::parse`] reads. Writing to memory fails
-    /// only on a row of another length than the header, which [`TrialSet::csv_for`]
-    /// reports; this gives the text written up to there.
-    pub fn to_csv(&self) -> String {
-        self.write_csv().0
-    }
-
-    /// The trials as CSV for the file `path`; a write error names that file.
-    pub fn csv_for(&self, path: &Path) -> Result<String, GapError> {
-        let (text, result) = self.write_csv();
-        result.map(|()| text).map_err(|e| GapError::File {
-            path: path.display().to_string(),
-            message: format!("cannot write the trials as CSV: {e}"),
-        })
-    }
-
-    /// The CSV text written, and the first write error (the rows after it are not written).
-    fn write_csv(&self) -> (String, Result<(), csv::Error>) {
+    /// only on a row of another length than the header (a bug, not bad input): an error
+    /// rather than a file cut short.
+    pub fn to_csv(&self) -> Result<String, GapError> {
+        let failed = |e: &dyn std::fmt::Display| {
+            GapError::Invalid(format!("cannot write the trials as CSV: {e}"))
+        };
         let mut w = csv::WriterBuilder::new().from_writer(Vec::new());
-        let result = std::iter::once(w.write_record(columns()))
-            .chain(self.trials.iter().map(|t| w.write_record(trial_row(t))))
-            .collect::<Result<(), csv::Error>>();
-        let text = w
-            .into_inner()
-            .map(|v| String::from_utf8(v).unwrap_or_default())
-            .unwrap_or_default();
-        (text, result)
+        w.write_record(columns()).map_err(|e| failed(&e))?;
+        for t in &self.trials {
+            w.write_record(trial_row(t)).map_err(|e| failed(&e))?;
+        }
+        let bytes = w.into_inner().map_err(|e| failed(&e))?;
+        String::from_utf8(bytes).map_err(|e| failed(&e))
     }
 }
 
