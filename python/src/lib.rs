@@ -204,60 +204,18 @@ fn predict_json(
         let pred = p::predict(&table, class, &req)?;
         let design = from_.as_deref().and_then(|r| r.strip_prefix("design:"));
         let torque = match (design, leg_length_m) {
-            (Some(name), Some(l)) => Some(torque_need(
-                &pred,
+            (Some(name), Some(l)) => Some(robot_survey::study::torque_need::for_prediction(
                 name,
-                l,
                 torque_contact,
+                l,
+                &pred.reference_masses(),
                 torque_margin,
                 table3_points.as_deref(),
             )?),
             _ => None,
         };
-        Ok(match torque {
-            Some(t) => report::json(&PredictionWithTorque {
-                prediction: &pred,
-                torque: &t,
-            })?,
-            None => report::json(&pred)?,
-        })
+        Ok(report::prediction_json(&pred, torque.as_ref())?)
     })
-}
-
-/// `survey predict` with the required hip torque of a design (the CLI's JSON shape).
-#[derive(serde::Serialize)]
-struct PredictionWithTorque<'a> {
-    #[serde(flatten)]
-    prediction: &'a robot_survey::analysis::prediction::Prediction,
-    torque: &'a robot_survey::study::torque_need::TorqueNeed,
-}
-
-/// As the CLI's `torque_need`: Table III's minimum torque at the fit's and the scaled
-/// reference's masses, and the catalogue's actuators that deliver it with the margin.
-fn torque_need(
-    pred: &robot_survey::analysis::prediction::Prediction,
-    design: &str,
-    leg_length_m: f64,
-    torque_contact: ContactScaling,
-    torque_margin: f64,
-    points_file: Option<&Path>,
-) -> Res<robot_survey::study::torque_need::TorqueNeed> {
-    if !(torque_margin.is_finite() && torque_margin > 0.0) {
-        anyhow::bail!("--torque-margin must be > 0, got {torque_margin}");
-    }
-    let points = table3::points(points_file)?;
-    let motors = robot_survey::motors::MotorCatalogue::locate(None).ok();
-    let masses = pred.reference_masses();
-    Ok(robot_survey::study::torque_need::torque_need(
-        &points,
-        design,
-        MassLaw::L2,
-        torque_contact,
-        leg_length_m,
-        &masses,
-        motors.as_ref(),
-        torque_margin,
-    )?)
 }
 
 /// A walker design (`dataset/walkers/*.toml`): read, change a number, simulate.
@@ -493,18 +451,7 @@ impl table3::Observer for Progress {
     fn point_done(&self, p: &Table3Point, resumed: bool) {
         let done = self.done.fetch_add(1, Ordering::Relaxed) + 1;
         let Some(cb) = &self.callback else { return };
-        let message = format!(
-            "{} {:?} {:?} L = {} m{}",
-            p.design,
-            p.mass_law,
-            p.contact,
-            p.leg_length_m,
-            if resumed {
-                " (from the points file)"
-            } else {
-                ""
-            }
-        );
+        let message = p.progress_label(resumed);
         Python::attach(|py| {
             if let Err(e) = cb.call1(py, (done, self.total, message)) {
                 e.print(py);

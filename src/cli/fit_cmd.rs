@@ -151,14 +151,7 @@ pub struct PredictArgs {
     pub table3: Option<PathBuf>,
 }
 
-/// `survey predict` with the required hip torque of a design.
-#[derive(serde::Serialize)]
-struct PredictionWithTorque<'a> {
-    #[serde(flatten)]
-    prediction: &'a robot_survey::analysis::prediction::Prediction,
-    torque: &'a robot_survey::study::torque_need::TorqueNeed,
-}
-
+/// The design's required hip torque at the target leg length (none without one).
 fn torque_need(
     a: &PredictArgs,
     design: &str,
@@ -167,24 +160,13 @@ fn torque_need(
     let Some(l) = a.leg_length else {
         return Ok(None);
     };
-    if !(a.torque_margin.is_finite() && a.torque_margin > 0.0) {
-        anyhow::bail!("--torque-margin must be > 0, got {}", a.torque_margin);
-    }
-    let points = robot_survey::study::table3::points(a.table3.as_deref())?;
-    // A ./dataset/motors that does not load is an error (as for torque-check), not a
-    // prediction silently without the motor comparison; without that folder the bundled
-    // catalogue is used.
-    let motors = robot_survey::motors::MotorCatalogue::locate(None)?;
-    let masses = pred.reference_masses();
-    Ok(Some(robot_survey::study::torque_need::torque_need(
-        &points,
+    Ok(Some(robot_survey::study::torque_need::for_prediction(
         design,
-        robot_survey::sim::MassLaw::L2,
         a.torque_contact,
         l,
-        &masses,
-        Some(&motors),
+        &pred.reference_masses(),
         a.torque_margin,
+        a.table3.as_deref(),
     )?))
 }
 
@@ -219,11 +201,7 @@ pub fn predict(a: &PredictArgs) -> anyhow::Result<ExitCode> {
         eprintln!("wrote {}", path.display());
     }
     print(&match (a.format, &torque) {
-        (Format::Json, Some(t)) => report::json(&PredictionWithTorque {
-            prediction: &pred,
-            torque: t,
-        })?,
-        (Format::Json, None) => report::json(&pred)?,
+        (Format::Json, t) => report::prediction_json(&pred, t.as_ref())?,
         (Format::Md, t) => {
             let mut s = report::prediction_text(&pred);
             if let Some(t) = t {

@@ -258,18 +258,7 @@ struct Bar(indicatif::ProgressBar);
 
 impl table3::Observer for Bar {
     fn point_done(&self, p: &Table3Point, resumed: bool) {
-        self.0.set_message(format!(
-            "{} {:?} {:?} L = {} m{}",
-            p.design,
-            p.mass_law,
-            p.contact,
-            p.leg_length_m,
-            if resumed {
-                " (from the points file)"
-            } else {
-                ""
-            }
-        ));
+        self.0.set_message(p.progress_label(resumed));
         self.0.inc(1);
     }
 }

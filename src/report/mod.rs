@@ -38,6 +38,24 @@ pub fn json<T: Serialize + ?Sized>(value: &T) -> Result<String, serde_json::Erro
     Ok(s)
 }
 
+/// `survey predict --format json`: the prediction, with the design's required hip torque
+/// beside it when asked for (`--from design:NAME` and a leg length).
+pub fn prediction_json(
+    prediction: &crate::analysis::prediction::Prediction,
+    torque: Option<&crate::study::torque_need::TorqueNeed>,
+) -> Result<String, serde_json::Error> {
+    #[derive(Serialize)]
+    struct WithTorque<'a> {
+        #[serde(flatten)]
+        prediction: &'a crate::analysis::prediction::Prediction,
+        torque: &'a crate::study::torque_need::TorqueNeed,
+    }
+    match torque {
+        Some(torque) => json(&WithTorque { prediction, torque }),
+        None => json(prediction),
+    }
+}
+
 /// Validation findings, one per line, then a summary.
 pub fn validation_text(rep: &ValidationReport) -> String {
     let mut out = String::new();

@@ -14,6 +14,12 @@ pub enum StudyError {
     InvalidOption { option: String, reason: String },
     #[error(transparent)]
     Checkpoint(#[from] crate::checkpoint::CheckpointError),
+    /// The actuator catalogue (`./dataset/motors` or the bundled one) does not load.
+    #[error(transparent)]
+    Motors(#[from] crate::motors::MotorError),
+    /// `survey predict --torque-margin`: the stall torque's margin over the requirement.
+    #[error("--torque-margin must be > 0, got {0}")]
+    TorqueMargin(f64),
     /// A data file (motor laws, actuators) that does not parse or holds a bad value.
     #[error("{origin}: {message}")]
     Data { origin: String, message: String },

@@ -225,6 +225,25 @@ pub struct Table3Point {
     pub peak_torque_nm: Option<f64>,
 }
 
+impl Table3Point {
+    /// One line of a sweep's progress: which chain and size finished (and whether it came
+    /// from the points file of an earlier run).
+    pub fn progress_label(&self, resumed: bool) -> String {
+        format!(
+            "{} {:?} {:?} L = {} m{}",
+            self.design,
+            self.mass_law,
+            self.contact,
+            self.leg_length_m,
+            if resumed {
+                " (from the points file)"
+            } else {
+                ""
+            }
+        )
+    }
+}
+
 impl SweepPoint for Table3Point {
     fn key(&self) -> String {
         point_key(&self.design, self.mass_law, self.contact, self.leg_length_m)

@@ -61,6 +61,36 @@ pub struct TorqueNeed {
     pub actuators: Vec<ActuatorOption>,
 }
 
+/// `survey predict --from design:NAME`'s torque (the CLI and the Python package): Table
+/// III's m ∝ L² chain under `contact`, read from `points_file` (None: the bundled
+/// points), at the candidate `masses`, with the actuators of the catalogue
+/// (`MotorCatalogue::locate`: a `./dataset/motors` that does not load is an error, not a
+/// prediction silently without the motor comparison).
+pub fn for_prediction(
+    design: &str,
+    contact: ContactScaling,
+    leg_length_m: f64,
+    masses: &[(String, f64, Option<[f64; 2]>)],
+    torque_margin: f64,
+    points_file: Option<&std::path::Path>,
+) -> Result<TorqueNeed, StudyError> {
+    if !(torque_margin.is_finite() && torque_margin > 0.0) {
+        return Err(StudyError::TorqueMargin(torque_margin));
+    }
+    let points = super::table3::points(points_file)?;
+    let motors = MotorCatalogue::locate(None)?;
+    torque_need(
+        &points,
+        design,
+        MassLaw::L2,
+        contact,
+        leg_length_m,
+        masses,
+        Some(&motors),
+        torque_margin,
+    )
+}
+
 /// `masses`: (label, mass, interval) candidates; the first one sizes the actuators.
 #[allow(clippy::too_many_arguments)]
 pub fn torque_need(
