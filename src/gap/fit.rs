@@ -852,8 +852,7 @@ pub fn groupings(conditions: &[Condition]) -> Vec<(String, Vec<usize>)> {
             "drive frequency",
             Box::new(|c: &Condition| {
                 let own = c
-                    .design
-                    .scaled(c.leg_length_m, c.mass_law, c.contact)
+                    .scaled_design()
                     .ok()
                     .and_then(|d| d.controller().frequency_hz())
                     .unwrap_or(f64::NAN);

@@ -191,18 +191,23 @@ impl Condition {
         Ok(d)
     }
 
+    /// The design scaled to the condition's size, before the condition's own settings
+    /// (drive, amplitude, payload, slope): its defaults at that size.
+    pub fn scaled_design(&self) -> Result<Design, GapError> {
+        self.design
+            .scaled(self.leg_length_m, self.mass_law, self.contact)
+            .map_err(|e| GapError::Sim {
+                origin: self.design.name.clone(),
+                source: e,
+            })
+    }
+
     /// The drive frequency the condition runs at: its own, or the design's scaled to its size.
     pub fn drive_frequency_hz(&self) -> Result<f64, GapError> {
         if let Some(f) = self.frequency_hz {
             return Ok(f);
         }
-        let d = self
-            .design
-            .scaled(self.leg_length_m, self.mass_law, self.contact)
-            .map_err(|e| GapError::Sim {
-                origin: self.design.name.clone(),
-                source: e,
-            })?;
+        let d = self.scaled_design()?;
         Ok(d.controller().frequency_hz().unwrap_or(f64::NAN))
     }
 

@@ -151,7 +151,7 @@ pub fn suggest(
     let base = conditions[robot].clone();
     let design = set.trials[robot].design.clone();
     let relative_sd = trials_relative_sd(set).unwrap_or(opts.default_relative_sd);
-    let pool = pool_conditions(&base)?;
+    let (pool, default_index) = pool_conditions(&base)?;
     let models = [
         super::knob::ModelSetting::nominal(),
         settings[0].clone(),
@@ -205,10 +205,7 @@ pub fn suggest(
                 0.0
             }
     };
-    let default_condition = {
-        let i = pool.iter().position(|c| is_default(c, &base));
-        i.and_then(|i| score(&pool[i], &walks[i]))
-    };
+    let default_condition = default_index.and_then(|i| score(&pool[i], &walks[i]));
     // Best first; ties (and equal floats) broken by the pool's order, so the answer is
     // deterministic.
     scored.sort_by(|a, b| total(b).total_cmp(&total(a)));
@@ -296,10 +293,7 @@ fn score_condition(
             .sum(),
         _ => 0.0,
     };
-    let scaled = c
-        .design
-        .scaled(c.leg_length_m, c.mass_law, c.contact)
-        .ok()?;
+    let scaled = c.scaled_design().ok()?;
     Some(Suggested {
         label: String::new(),
         leg_length_m: c.leg_length_m,
@@ -379,32 +373,36 @@ fn trials_relative_sd(set: &TrialSet) -> Option<f64> {
     Some(v[v.len() / 2])
 }
 
-fn pool_conditions(base: &Condition) -> Result<Vec<Condition>, GapError> {
-    let scaled = base
-        .design
-        .scaled(base.leg_length_m, base.mass_law, base.contact)
-        .map_err(|e| GapError::Sim {
-            origin: base.design.name.clone(),
-            source: e,
-        })?;
+/// The pool of conditions at the robot's size, and which of them is the default one (the
+/// design's own drive, amplitude and mass, level floor).
+fn pool_conditions(base: &Condition) -> Result<(Vec<Condition>, Option<usize>), GapError> {
+    let scaled = base.scaled_design()?;
     let f0 = scaled.controller().frequency_hz().unwrap_or(1.0);
     let m0 = scaled.mass.total_mass_kg;
     let servo_amplitude = match &base.design.control {
         ControlSpec::ServoSine { amplitude_deg, .. } => Some(*amplitude_deg),
         _ => None,
     };
-    let amplitudes: Vec<Option<f64>> = match servo_amplitude {
-        Some(a) => POOL.amplitude_factors.iter().map(|k| Some(a * k)).collect(),
-        None => vec![None],
+    let amplitudes: Vec<(Option<f64>, bool)> = match servo_amplitude {
+        Some(a) => POOL
+            .amplitude_factors
+            .iter()
+            .map(|k| (Some(a * k), *k == 1.0))
+            .collect(),
+        None => vec![(None, true)],
     };
     let mut out = Vec::new();
+    let mut default = None;
     for &kf in POOL.frequency_factors {
-        for a in &amplitudes {
+        for &(a, own_amplitude) in &amplitudes {
             for &p in POOL.payload_fractions {
                 for &s in POOL.slopes_deg {
+                    if kf == 1.0 && own_amplitude && p == 0.0 && s == 0.0 && default.is_none() {
+                        default = Some(out.len());
+                    }
                     let mut c = base.clone();
                     c.frequency_hz = Some(f0 * kf);
-                    c.amplitude_deg = *a;
+                    c.amplitude_deg = a;
                     c.mass_kg = Some(m0 * (1.0 + p));
                     c.slope_deg = Some(s);
                     c.torque_nm = None;
@@ -413,25 +411,7 @@ fn pool_conditions(base: &Condition) -> Result<Vec<Condition>, GapError> {
             }
         }
     }
-    Ok(out)
-}
-
-fn is_default(c: &Condition, base: &Condition) -> bool {
-    let Ok(scaled) = base
-        .design
-        .scaled(base.leg_length_m, base.mass_law, base.contact)
-    else {
-        return false;
-    };
-    let f0 = scaled.controller().frequency_hz().unwrap_or(1.0);
-    let a0 = match &base.design.control {
-        ControlSpec::ServoSine { amplitude_deg, .. } => Some(*amplitude_deg),
-        _ => None,
-    };
-    c.frequency_hz == Some(f0)
-        && c.amplitude_deg == a0
-        && c.mass_kg == Some(scaled.mass.total_mass_kg)
-        && c.slope_deg == Some(0.0)
+    Ok((out, default))
 }
 
 /// The suggestions as trial rows (a trials CSV the lab fills in).
