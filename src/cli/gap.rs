@@ -142,6 +142,13 @@ pub struct DiagnoseArgs {
     /// Figure of the standardised residuals per condition, before and after (SVG or PNG).
     #[arg(long, value_name = "FILE")]
     pub plot: Option<PathBuf>,
+    /// Experimental: rounds of the exchange step after forward selection. The answer's
+    /// model is compared with its same-size neighbours (other pairs of knobs, or one knob
+    /// exchanged); a better one replaces it only if its knobs form a chain every rule
+    /// accepts, and one that fits alike makes the exchanged knobs "not told apart". Off (0)
+    /// until the benchmark has measured it.
+    #[arg(long, default_value_t = 0, value_parser = clap::value_parser!(u8).range(0..=4))]
+    pub exchange_rounds: u8,
 }
 
 #[derive(Args, Debug)]
@@ -581,6 +588,10 @@ fn diagnose(a: &DiagnoseArgs) -> anyhow::Result<ExitCode> {
         default_relative_sd: a.default_sd,
         alpha: a.alpha,
         calibrate: !a.no_calibration,
+        select: gap::select::SelectOptions {
+            exchange_rounds: usize::from(a.exchange_rounds),
+            ..gap::select::SelectOptions::default()
+        },
         ..DiagnoseOptions::default()
     };
     let pb = indicatif::ProgressBar::new_spinner();

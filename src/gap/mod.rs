@@ -13,7 +13,8 @@
 //!   with a per-model correction from real walks.
 //! * [`problem`] (the χ² cost), [`solver`] (Nelder–Mead, scans), [`fit`] (surrogate fit,
 //!   refinement with walks, held-out χ², profiles, consistency across groups).
-//! * [`select`]: forward selection with the call rules; [`diagnose`]: the answer;
+//! * [`select`]: forward selection with the call rules, the backward pass and an
+//!   (experimental, off by default) exchange step; [`diagnose`]: the answer;
 //!   [`locate`]: where the gap lies; [`identify`]: detection and identification thresholds.
 //! * [`waveform`]: a robot's log (time, hip angle, attitude, torque) reduced to the Fourier
 //!   coefficients of its steady cycle, and their χ² against a simulated cycle;
@@ -24,7 +25,8 @@
 //! * [`benchmark`]: the diagnosis on cases of known cause, inside and outside its library;
 //!   [`waveform_bench`]: what the logged cycles buy on the look-alike pairs.
 //!
-//! Depends on [`crate::sim`] (the simulator) and [`crate::regression`] (distributions) only.
+//! Depends on [`crate::sim`] (the simulator), [`crate::regression`] (distributions) and
+//! [`crate::checkpoint`] (the benchmark's resumable points file) only.
 
 pub mod benchmark;
 pub mod cache;

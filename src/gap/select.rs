@@ -490,6 +490,15 @@ impl Selector<'_, '_> {
         )))
     }
 
+    /// Knobs by label, joined by " + " (a model's knob set in a note).
+    fn label_set(&self, set: &[usize]) -> String {
+        let knobs = &self.ctx.knobs.list;
+        set.iter()
+            .map(|k| knobs[*k].label())
+            .collect::<Vec<_>>()
+            .join(" + ")
+    }
+
     /// Every free knob's value in SI.
     fn values_si(&self, fit: &Fit) -> Vec<(String, f64)> {
         let knobs = &self.ctx.knobs.list;
@@ -714,12 +723,6 @@ impl Selector<'_, '_> {
             walked.push((set, real));
         }
         walked.sort_by(|a, b| a.1.chi2.total_cmp(&b.1.chi2));
-        let label_set = |set: &[usize]| -> String {
-            set.iter()
-                .map(|k| knobs[*k].label())
-                .collect::<Vec<_>>()
-                .join(" + ")
-        };
         for (set, real) in &walked {
             let in_range = real.unit.iter().all(|t| (0.01..=0.99).contains(t));
             let better = real.chi2 < current.chi2 - margin
@@ -735,8 +738,8 @@ impl Selector<'_, '_> {
                     self.notes.push(format!(
                         "{} fits better than {} (χ² {:.1} vs {:.1}) but its knobs do not form a \
                          chain every rule accepts ({why}): not taken",
-                        label_set(set),
-                        label_set(&current.active),
+                        self.label_set(set),
+                        self.label_set(&current.active),
                         real.chi2,
                         current.chi2
                     ));
@@ -753,8 +756,8 @@ impl Selector<'_, '_> {
             self.notes.push(format!(
                 "{} replaced {} (χ² {:.1} → {:.1}): forward selection had taken a look-alike \
                  first; the chain below is rebuilt from the nominal in the new model's order",
-                label_set(set),
-                label_set(&current.active),
+                self.label_set(set),
+                self.label_set(&current.active),
                 current.chi2,
                 fit.chi2
             ));
@@ -773,8 +776,9 @@ impl Selector<'_, '_> {
         Ok(false)
     }
 
-    /// No neighbour is better: those within the identification distance `margin` are
-    /// look-alikes of the knobs they exchange, unless their new knobs are further causes
+    /// No neighbour replaced the model: those that fit within the identification distance
+    /// `margin` (or better, but failing the chain's rules) are look-alikes of the knobs they
+    /// exchange, unless their new knobs are further causes
     /// (complements: significant once added to the model). The exchanged knobs' steps get
     /// them as rivals (ambiguous: none named).
     fn mark_look_alikes(
@@ -785,12 +789,6 @@ impl Selector<'_, '_> {
         margin: f64,
     ) -> Result<(), GapError> {
         let knobs = &self.ctx.knobs.list;
-        let label_set = |set: &[usize]| -> String {
-            set.iter()
-                .map(|k| knobs[*k].label())
-                .collect::<Vec<_>>()
-                .join(" + ")
-        };
         let alpha = self.opts.alpha / knobs.len().max(1) as f64;
         for (set, real) in walked {
             if real.chi2 - current.chi2 >= margin {
@@ -811,13 +809,21 @@ impl Selector<'_, '_> {
                 .filter(|k| !set.contains(k))
                 .map(|k| knobs[*k].label())
                 .collect();
+            // A neighbour better by more than the distance reaches here only when its knobs
+            // failed the chain's rules: not an answer, but the model's own knob is then no
+            // better identified than by "fits alike".
+            let how = if real.chi2 < current.chi2 - margin {
+                "fits these trials better (though not as a chain the rules accept) than"
+            } else {
+                "fits these trials as well as"
+            };
             self.notes.push(format!(
-                "{} and {} fit these trials alike (χ² {:.1} vs {:.1}, identification distance \
-                 {margin:.1}): {} not named",
-                label_set(&current.active),
-                label_set(set),
-                current.chi2,
+                "{} {how} {} (χ² {:.1} vs {:.1}, identification distance {margin:.1}): {} \
+                 not named",
+                self.label_set(set),
+                self.label_set(&current.active),
                 real.chi2,
+                current.chi2,
                 out.join(", ")
             ));
             for step in steps.iter_mut().filter(|s| out.contains(&s.knob)) {
@@ -883,15 +889,12 @@ impl Selector<'_, '_> {
                         }
                     }
                     Err(why) => {
-                        whys.push(format!("{} after {}: {why}", knobs[c].label(), {
-                            let before: Vec<String> =
-                                current.active.iter().map(|k| knobs[*k].label()).collect();
-                            if before.is_empty() {
-                                "the nominal".to_string()
-                            } else {
-                                before.join(" + ")
-                            }
-                        }));
+                        let after = if current.active.is_empty() {
+                            "the nominal".to_string()
+                        } else {
+                            self.label_set(&current.active)
+                        };
+                        whys.push(format!("{} after {after}: {why}", knobs[c].label()));
                         passed = false;
                         break;
                     }
