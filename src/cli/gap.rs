@@ -94,6 +94,12 @@ pub struct SynthArgs {
     pub noise: f64,
     #[arg(long, default_value_t = 0)]
     pub seed: u64,
+    /// Write the expected values: no noise drawn, the _sd columns as --noise gives them. What
+    /// such trials show on average: a cause `gap diagnose` cannot name from them is not
+    /// identifiable from these conditions at this noise, whatever the draw. (Logs, with
+    /// --logs, keep their sensor noise.)
+    #[arg(long)]
+    pub expected: bool,
     /// Output trials CSV.
     #[arg(long, value_name = "FILE")]
     pub out: PathBuf,
@@ -312,9 +318,11 @@ pub struct BenchmarkArgs {
     /// Points files of shards to merge into --points (no cases are run).
     #[arg(long, num_args = 1.., value_name = "FILE")]
     pub merge: Vec<PathBuf>,
-    /// Run only the cases of these kinds (null, effect, pair, parameter, drake), e.g. to
-    /// spend a short session on the pairs: the points file stays the same benchmark's, and
-    /// the report scores every row it holds. With --shard, slices are taken after the filter.
+    /// Run only the cases of these kinds (null, effect, pair, pair-expected, parameter,
+    /// compound, drake), e.g. to spend a short session on the pairs: the points file stays
+    /// the same benchmark's, and the report scores every row it holds. With --shard, slices
+    /// are taken after the filter. pair-expected: each pair on its noise-free trials (the
+    /// ceiling of any rule); compound: a declared parameter error plus each effect.
     #[arg(long, value_delimiter = ',', value_name = "KIND")]
     pub kinds: Vec<String>,
     /// Folder for gap-benchmark.md, .json and .svg.
@@ -359,9 +367,13 @@ fn bar(len: u64, what: &str) -> indicatif::ProgressBar {
 fn synth(a: &SynthArgs) -> anyhow::Result<ExitCode> {
     let lib = EffectLibrary::bundled()?;
     let design = Design::resolve(&a.design)?;
-    let (opts, mut command) = gap::synth::SynthOptions::from_args(
+    let (mut opts, mut command) = gap::synth::SynthOptions::from_args(
         &lib, &design, &a.design, &a.effects, &a.set, a.noise, a.seed,
     )?;
+    if a.expected {
+        opts.expected = true;
+        command.push_str(" --expected");
+    }
     let conditions = match &a.conditions {
         Some(p) => Some(TrialSet::read(p)?),
         None => None,
@@ -702,7 +714,7 @@ fn benchmark(a: &BenchmarkArgs) -> anyhow::Result<ExitCode> {
     let progress = |what: &str| pb.set_message(what.to_string());
     progress("planning: thresholds and cases");
     let mut plan = gap::benchmark::plan(&lib, &opts, &progress)?;
-    const KINDS: [&str; 5] = ["null", "effect", "pair", "parameter", "drake"];
+    use gap::benchmark::KINDS;
     if let Some(bad) = a.kinds.iter().find(|k| !KINDS.contains(&k.as_str())) {
         anyhow::bail!(
             "--kinds {bad}: not a case kind (one of {})",

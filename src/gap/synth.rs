@@ -103,7 +103,30 @@ pub fn add_noise(
     seed: u64,
     source: &str,
 ) -> Vec<Trial> {
-    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    measured(conditions, truth, noise, Some(seed), source)
+}
+
+/// The expected trials: every value the truth's, every sd FRACTION·|value| as in
+/// [`add_noise`]. What a trial set shows on average: a cause the diagnosis cannot name
+/// from these is not identifiable from such trials at that noise, whatever the draw.
+pub fn expected_trials(
+    conditions: &[Trial],
+    truth: &[SimMetrics],
+    noise: f64,
+    source: &str,
+) -> Vec<Trial> {
+    measured(conditions, truth, noise, None, source)
+}
+
+/// Trials from true metrics with noise drawn from `seed`, or none (`None`: expected values).
+fn measured(
+    conditions: &[Trial],
+    truth: &[SimMetrics],
+    noise: f64,
+    seed: Option<u64>,
+    source: &str,
+) -> Vec<Trial> {
+    let mut rng = ChaCha8Rng::seed_from_u64(seed.unwrap_or(0));
     let mut out = Vec::with_capacity(conditions.len());
     for (t, m) in conditions.iter().zip(truth) {
         let mut t = t.clone();
@@ -113,6 +136,7 @@ pub fn add_noise(
             // Draw even for a missing value, so one trial's fall does not shift the noise of
             // the others.
             let e = normal(&mut rng);
+            let e = if seed.is_some() { e } else { 0.0 };
             if !v.is_finite() {
                 continue;
             }
@@ -192,6 +216,9 @@ pub struct SynthOptions {
     pub params: Vec<(String, f64)>,
     pub noise: f64,
     pub seed: u64,
+    /// Write the expected values (no noise drawn; the sd columns as with the noise): what
+    /// such trials show on average, to ask whether a cause is identifiable at all.
+    pub expected: bool,
 }
 
 impl SynthOptions {
@@ -236,6 +263,7 @@ impl SynthOptions {
                 params,
                 noise,
                 seed,
+                expected: false,
             },
             command,
         ))
@@ -256,12 +284,24 @@ pub fn synthesize(
     let resolved = resolve(&set)?;
     let setting = setting_of(opts, &resolved);
     let truth = truth_metrics(&resolved, lib, &setting, progress)?;
-    let trials = add_noise(&set.trials, &truth, opts.noise, opts.seed, command);
+    let trials = opts.trials(&set.trials, &truth, command);
     Ok(TrialSet {
         origin: set.origin,
         base_dir: set.base_dir,
         trials,
     })
+}
+
+impl SynthOptions {
+    /// The measured trials from the true metrics: noise drawn from the seed, or the expected
+    /// values.
+    fn trials(&self, conditions: &[Trial], truth: &[SimMetrics], source: &str) -> Vec<Trial> {
+        if self.expected {
+            expected_trials(conditions, truth, self.noise, source)
+        } else {
+            add_noise(conditions, truth, self.noise, self.seed, source)
+        }
+    }
 }
 
 fn check_noise(noise: f64) -> Result<(), GapError> {
@@ -348,7 +388,7 @@ pub fn synthesize_logs(
         })
         .collect::<Result<_, _>>()?;
     let truth: Vec<SimMetrics> = walked.iter().map(|w| w.0).collect();
-    let trials = add_noise(&set.trials, &truth, opts.noise, opts.seed, command);
+    let trials = opts.trials(&set.trials, &truth, command);
     let logs = walked
         .iter()
         .enumerate()

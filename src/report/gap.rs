@@ -707,7 +707,7 @@ fn confusions_md(o: &mut String, b: &BenchmarkSummary) {
 fn outside_cases_md(o: &mut String, rows: &[CaseRow]) {
     let listed: Vec<&CaseRow> = rows
         .iter()
-        .filter(|r| r.kind == "parameter" || r.kind == "drake" || r.kind == "pair")
+        .filter(|r| r.kind != "null" && r.kind != "effect")
         .collect();
     if !listed.is_empty() {
         let _ = writeln!(

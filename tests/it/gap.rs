@@ -283,9 +283,9 @@ fn synth_is_deterministic_and_its_noise_is_stated() {
         "design,leg_length_m,frequency_hz,source\nmugatu,0.153,1.24,x\nmugatu,0.306,0.877,x\n",
     )
     .expect("write");
-    let run = |out: &str| {
+    let run_with = |out: &str, extra: &[&str]| {
         let p = dir.path().join(out);
-        let o = survey(&[
+        let mut args = vec![
             "gap",
             "synth",
             "--conditions",
@@ -298,10 +298,13 @@ fn synth_is_deterministic_and_its_noise_is_stated() {
             "4",
             "--out",
             p.to_str().expect("utf-8"),
-        ]);
+        ];
+        args.extend_from_slice(extra);
+        let o = survey(&args);
         assert!(o.status.success(), "{}", stderr(&o));
         std::fs::read_to_string(p).expect("read")
     };
+    let run = |out: &str| run_with(out, &[]);
     let (a, b) = (run("a.csv"), run("b.csv"));
     assert_eq!(a, b, "same seed, same bytes");
     let set = TrialSet::parse(&a, "a.csv", dir.path()).expect("synth output parses");
@@ -313,6 +316,35 @@ fn synth_is_deterministic_and_its_noise_is_stated() {
         assert!((0.04..0.065).contains(&ratio), "{ratio}");
         assert!(t.source.contains("--effect hip_viscous_damping=0.01"));
     }
+    // --expected: the truth itself, with the same sd (0.05·|truth|, as the noisy file
+    // states): sd/value = 0.05 up to the file's rounding, and the noisy value differs.
+    let e = run_with("e.csv", &["--expected"]);
+    let expected = TrialSet::parse(&e, "e.csv", dir.path()).expect("expected output parses");
+    let mut drawn = 0;
+    for (x, t) in expected.trials.iter().zip(&set.trials) {
+        assert!(x.source.contains("--expected"), "{}", x.source);
+        for (mx, mt) in x.measured.iter().zip(&t.measured) {
+            let (Some(mx), Some(mt)) = (mx, mt) else {
+                assert_eq!(mx.is_some(), mt.is_some());
+                continue;
+            };
+            let sd = mx.sd.expect("sd");
+            assert!(
+                (sd / mx.value.abs() - 0.05).abs() < 1e-5,
+                "{sd} vs {}",
+                mx.value
+            );
+            assert!(
+                (sd / mt.sd.expect("sd") - 1.0).abs() < 1e-5,
+                "same sd in both files"
+            );
+            drawn += usize::from(mx.value != mt.value);
+        }
+    }
+    assert!(
+        drawn > 0,
+        "the seeded file has noise the expected one has not"
+    );
 }
 
 #[test]

@@ -400,6 +400,49 @@ fn benchmark_scores_count_what_the_rows_say() {
         "mugatu:ground.slope_deg",
         "",
     ));
+    // Expected (noise-free) pairs: scored apart, the ceiling of the noisy pairs.
+    rows.push(row(
+        "pair-expected",
+        "hip_coulomb_friction=0.02;hip_viscous_damping=0.007",
+        "",
+        "hip_viscous_damping",
+        "",
+        "",
+    ));
+    rows.push(row(
+        "pair-expected",
+        "hip_coulomb_friction=0.02;soft_ground=3000000",
+        "",
+        "hip_coulomb_friction;soft_ground",
+        "",
+        "",
+    ));
+    // Compound cases: a declared parameter error plus an effect.
+    rows.push(row(
+        "compound",
+        "hip_backlash=10",
+        "ground.slope_deg=1.5",
+        "hip_backlash",
+        "mugatu:ground.slope_deg",
+        "",
+    ));
+    rows.push(row(
+        "compound",
+        "soft_ground=5000000",
+        "ground.slope_deg=1.5",
+        "rolling_resistance",
+        "mugatu:ground.slope_deg",
+        "",
+    ));
+    // The effect named through its parameter alias, the slope missed: nothing spurious.
+    rows.push(row(
+        "compound",
+        "friction_coefficient=0.34",
+        "ground.slope_deg=1.5",
+        "",
+        "mugatu:contact.friction_mu",
+        "",
+    ));
     let opts = BenchmarkOptions::standard("mugatu");
     let s = summarize(&rows, &lib, &opts, Default::default());
     let get = |what: &str| {
@@ -419,6 +462,20 @@ fn benchmark_scores_count_what_the_rows_say() {
     assert_eq!((wrong_effect.k, wrong_effect.n), (1, 2));
     let wrong_param = get("main: parameter errors: a wrong parameter named");
     assert_eq!((wrong_param.k, wrong_param.n), (1, 2));
+    let ceiling = get("pairs of effects at 2× thresholds, on their expected");
+    assert_eq!((ceiling.k, ceiling.n), (1, 2));
+    let ceiling_third = get("pairs on their expected trials: a spurious");
+    assert_eq!((ceiling_third.k, ceiling_third.n), (0, 2));
+    let compound = |what: &str| {
+        let x = get(&format!(
+            "compound (declared parameter error + effect at 2× threshold): {what}"
+        ));
+        (x.k, x.n)
+    };
+    assert_eq!(compound("the effect named"), (2, 3));
+    assert_eq!(compound("the parameter named"), (2, 3));
+    assert_eq!(compound("both named"), (1, 3));
+    assert_eq!(compound("a knob in neither named"), (1, 3));
     let cov = get("95 % intervals holding the truth");
     assert_eq!((cov.k, cov.n), (1, 1));
 }
