@@ -9,6 +9,7 @@ use super::knob::ModelSetting;
 use super::library::{EffectLibrary, EffectSetting};
 use super::simulate::{Condition, SimMetrics, resolve};
 use super::trials::{Measurement, Metric, Trial, TrialSet};
+use crate::progress::Observer;
 use crate::sim::{Design, WalkOptions, simulate_walk};
 
 /// Drive frequencies tried around the design's, as factors; the default conditions keep
@@ -249,7 +250,7 @@ pub fn synthesize(
     opts: &SynthOptions,
     conditions: Option<TrialSet>,
     command: &str,
-    progress: &(dyn Fn() + Sync),
+    progress: &dyn Observer,
 ) -> Result<TrialSet, GapError> {
     check_noise(opts.noise)?;
     let set = conditions_or_default(opts, conditions)?;
@@ -310,14 +311,14 @@ pub fn truth_metrics(
     conditions: &[Condition],
     lib: &EffectLibrary,
     setting: &ModelSetting,
-    progress: &(dyn Fn() + Sync),
+    progress: &dyn Observer,
 ) -> Result<Vec<SimMetrics>, GapError> {
     use rayon::prelude::*;
     conditions
         .par_iter()
         .map(|c| {
             let r = c.simulate(lib, setting);
-            progress();
+            progress.tick();
             r
         })
         .collect()
@@ -332,7 +333,7 @@ pub fn synthesize_logs(
     conditions: Option<TrialSet>,
     command: &str,
     sensor: SensorNoise,
-    progress: &(dyn Fn() + Sync),
+    progress: &dyn Observer,
 ) -> Result<(TrialSet, Vec<Vec<super::waveform::LogSample>>), GapError> {
     use rayon::prelude::*;
     check_noise(opts.noise)?;
@@ -343,7 +344,7 @@ pub fn synthesize_logs(
         .par_iter()
         .map(|c| {
             let r = c.walk(lib, &setting, true);
-            progress();
+            progress.tick();
             r
         })
         .collect::<Result<_, _>>()?;
