@@ -14,6 +14,8 @@
 //! - [`checkpoint`]: points files of long runs: resume after an interruption, shards, merge.
 //! - [`report`]: output formats (md, tex, csv, json) and figures.
 //! - [`io`]: writing files atomically.
+//! - [`progress`]: what long runs report as they go (an [`progress::Observer`]) and their
+//!   timings.
 
 pub mod analysis;
 pub mod checkpoint;
@@ -22,6 +24,7 @@ pub mod dataset;
 pub mod gap;
 pub mod io;
 pub mod motors;
+pub mod progress;
 pub mod regression;
 pub mod report;
 pub mod sim;

@@ -19,6 +19,7 @@ use pyo3::types::{PyBytes, PyDict, PyString};
 use robot_survey::analysis::table2::{self, Group};
 use robot_survey::dataset::{Dataset, SurveyTable};
 use robot_survey::gap::{self, DiagnoseOptions, EffectLibrary, TrialSet};
+use robot_survey::progress::Silent;
 use robot_survey::regression::Method;
 use robot_survey::report;
 use robot_survey::sim::{self, ContactScaling, Design, MassLaw, WalkOptions};
@@ -595,7 +596,7 @@ fn gap_synth_csv(
                 base_dir.as_deref().unwrap_or(Path::new(".")),
             )?),
         };
-        let out = gap::synth::synthesize(&lib, &opts, conditions, &command, &|| {})?;
+        let out = gap::synth::synthesize(&lib, &opts, conditions, &command, &Silent)?;
         Ok(out.to_csv()?)
     })
 }
@@ -633,7 +634,7 @@ fn gap_diagnose_json(
             calibrate,
             ..DiagnoseOptions::default()
         };
-        let (d, timing) = gap::diagnose(&set, &lib, &opts, &|_| {})?;
+        let (d, timing) = gap::diagnose(&set, &lib, &opts, &Silent)?;
         Ok((report::json(&d)?, serde_json::to_string(&timing)?))
     })
 }

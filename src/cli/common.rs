@@ -1,10 +1,13 @@
 //! What several commands share: exit codes, the dataset and method options, the
-//! confidence parser, the simulation output format, and printing. Kept in one file below
-//! the command files so that none of them reaches into another.
+//! confidence parser, the simulation output format, printing, and how a library run's
+//! progress is shown. Kept in one file below the command files so that none of them
+//! reaches into another.
 
 use std::path::PathBuf;
 
 use clap::ValueEnum;
+use indicatif::ProgressBar;
+use robot_survey::progress::Observer;
 use robot_survey::regression::Method;
 
 /// Exit code: the command ran and found problems.
@@ -71,5 +74,51 @@ pub fn print(text: &str) {
     let _ = out.write_all(text.as_bytes());
     if !text.ends_with('\n') {
         let _ = out.write_all(b"\n");
+    }
+}
+
+/// A library run's progress on stderr: the CLI's [`Observer`], in the three forms its
+/// commands use. Only what is shown lives here; the run decides what to report.
+pub enum Progress {
+    /// A bar (`{pos}/{len}` in its template): each finished unit advances it, each stage
+    /// becomes its message.
+    Bar(ProgressBar),
+    /// A spinner: each finished unit counts and turns it, each stage becomes its message and
+    /// turns it (it moves only when there is news, unless it has a steady tick).
+    Spinner(ProgressBar),
+    /// Each stage a line (a run of minutes to hours, whose log is worth keeping).
+    Lines,
+}
+
+impl Progress {
+    /// Takes a bar or spinner off the terminal once the run is over.
+    pub fn clear(&self) {
+        if let Progress::Bar(bar) | Progress::Spinner(bar) = self {
+            bar.finish_and_clear();
+        }
+    }
+}
+
+impl Observer for Progress {
+    fn tick(&self) {
+        match self {
+            Progress::Bar(bar) => bar.inc(1),
+            Progress::Spinner(spinner) => {
+                spinner.inc(1);
+                spinner.tick();
+            }
+            Progress::Lines => {}
+        }
+    }
+
+    fn stage(&self, what: &str) {
+        match self {
+            Progress::Bar(bar) => bar.set_message(what.to_string()),
+            Progress::Spinner(spinner) => {
+                spinner.set_message(what.to_string());
+                spinner.tick();
+            }
+            Progress::Lines => eprintln!("{what}"),
+        }
     }
 }

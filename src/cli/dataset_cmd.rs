@@ -317,8 +317,8 @@ fn fmt(a: &FmtArgs) -> anyhow::Result<ExitCode> {
 
 fn release(a: &ReleaseArgs) -> anyhow::Result<ExitCode> {
     let ds = load(&a.data)?;
-    let date = a.date.clone().unwrap_or_else(dataset::release::today_utc);
-    let out = dataset::release::cut_release(&ds, &a.version, &date, &a.note, a.allow_errors)?;
+    let date = a.date.clone().unwrap_or_else(dataset::publish::today_utc);
+    let out = dataset::publish::cut_release(&ds, &a.version, &date, &a.note, a.allow_errors)?;
     print(&format!(
         "released {} ({} robots, {} fitted)\n{}",
         out.version,

@@ -6,10 +6,11 @@ use std::process::ExitCode;
 use clap::{Args, Subcommand, ValueEnum};
 use robot_survey::gap::{self, DiagnoseOptions, EffectLibrary, TrialSet};
 use robot_survey::io::write_atomic;
+use robot_survey::progress::{Observer, Silent, Stopwatch};
 use robot_survey::report;
 use robot_survey::sim::Design;
 
-use super::common::print;
+use super::common::{Progress, print};
 
 #[derive(Args, Debug)]
 pub struct GapArgs {
@@ -354,14 +355,22 @@ fn effects(a: &EffectsArgs) -> anyhow::Result<ExitCode> {
     Ok(ExitCode::SUCCESS)
 }
 
-fn bar(len: u64, what: &str) -> indicatif::ProgressBar {
+/// A bar of `len` walks with the message `what`.
+fn bar(len: u64, what: &str) -> Progress {
     let bar = indicatif::ProgressBar::new(len);
     bar.set_style(
         indicatif::ProgressStyle::with_template("{msg} [{bar:30}] {pos}/{len} walks, {elapsed}")
             .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
     );
     bar.set_message(what.to_string());
-    bar
+    Progress::Bar(bar)
+}
+
+/// A spinner with the message `what`.
+fn spinner(what: &str) -> Progress {
+    let spinner = indicatif::ProgressBar::new_spinner();
+    spinner.set_message(what.to_string());
+    Progress::Spinner(spinner)
 }
 
 fn synth(a: &SynthArgs) -> anyhow::Result<ExitCode> {
@@ -381,8 +390,8 @@ fn synth(a: &SynthArgs) -> anyhow::Result<ExitCode> {
     let n = conditions.as_ref().map(|c| c.trials.len()).unwrap_or(12) as u64;
     let pb = bar(n, "simulating the trials");
     let Some(dir) = &a.logs else {
-        let set = gap::synth::synthesize(&lib, &opts, conditions, &command, &|| pb.inc(1))?;
-        pb.finish_and_clear();
+        let set = gap::synth::synthesize(&lib, &opts, conditions, &command, &pb)?;
+        pb.clear();
         write_atomic(&a.out, set.to_csv()?.as_bytes())?;
         eprintln!("wrote {} ({} trials)", a.out.display(), set.trials.len());
         return Ok(ExitCode::SUCCESS);
@@ -407,8 +416,8 @@ fn synth(a: &SynthArgs) -> anyhow::Result<ExitCode> {
         torque_fraction: a.sensor_noise_torque,
     };
     let (mut set, logs) =
-        gap::synth::synthesize_logs(&lib, &opts, conditions, &command, sensor, &|| pb.inc(1))?;
-    pb.finish_and_clear();
+        gap::synth::synthesize_logs(&lib, &opts, conditions, &command, sensor, &pb)?;
+    pb.clear();
     std::fs::create_dir_all(dir).map_err(|e| anyhow::anyhow!("{}: {e}", dir.display()))?;
     // The trials file names each log relative to its own folder.
     let out_dir = a
@@ -477,10 +486,9 @@ fn separate(a: &SeparateArgs) -> anyhow::Result<ExitCode> {
         default_relative_sd: a.default_sd,
         ..Default::default()
     };
-    let pb = indicatif::ProgressBar::new_spinner();
-    pb.set_message("walking the candidates");
-    let s = gap::separate::separate(&set, &lib, &opts, &|| pb.tick())?;
-    pb.finish_and_clear();
+    let pb = spinner("walking the candidates");
+    let s = gap::separate::separate(&set, &lib, &opts, &pb)?;
+    pb.clear();
     eprintln!("{} walks", s.walks);
     if let Some(p) = &a.plot {
         report::separation::cycles_plot(&s, p)?;
@@ -511,10 +519,9 @@ fn suggest(a: &SuggestArgs) -> anyhow::Result<ExitCode> {
         },
         default_relative_sd: a.default_sd,
     };
-    let pb = indicatif::ProgressBar::new_spinner();
-    pb.set_message("fitting the candidates, then walking the pool");
-    let s = gap::suggest::suggest(&set, &lib, &opts, &|| pb.tick())?;
-    pb.finish_and_clear();
+    let pb = spinner("fitting the candidates, then walking the pool");
+    let s = gap::suggest::suggest(&set, &lib, &opts, &pb)?;
+    pb.clear();
     if let Some(p) = &a.out {
         let next = TrialSet {
             origin: p.display().to_string(),
@@ -574,9 +581,9 @@ fn waveform_benchmark(a: &WaveformBenchArgs) -> anyhow::Result<ExitCode> {
     if !a.pairs.is_empty() {
         command.push_str(&format!(" --pairs {}", a.pairs.join(",")));
     }
-    let started = std::time::Instant::now();
-    let b = gap::waveform_bench::run(&lib, &opts, &|line| eprintln!("{line}"))?;
-    let elapsed = started.elapsed().as_secs_f64();
+    let clock = Stopwatch::start();
+    let b = gap::waveform_bench::run(&lib, &opts, &Progress::Lines)?;
+    let elapsed = clock.seconds();
     std::fs::create_dir_all(&a.out).map_err(|e| anyhow::anyhow!("{}: {e}", a.out.display()))?;
     let md = a.out.join("gap-waveforms.md");
     write_atomic(
@@ -606,18 +613,9 @@ fn diagnose(a: &DiagnoseArgs) -> anyhow::Result<ExitCode> {
         },
         ..DiagnoseOptions::default()
     };
-    let pb = indicatif::ProgressBar::new_spinner();
-    let count = std::sync::atomic::AtomicU64::new(0);
-    let (d, timing) = gap::diagnose(&set, &lib, &opts, &|what| {
-        if what.is_empty() {
-            let k = count.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1;
-            pb.set_position(k);
-            pb.tick();
-        } else {
-            pb.set_message(what.to_string());
-        }
-    })?;
-    pb.finish_and_clear();
+    let pb = Progress::Spinner(indicatif::ProgressBar::new_spinner());
+    let (d, timing) = gap::diagnose(&set, &lib, &opts, &pb)?;
+    pb.clear();
     eprintln!(
         "{} walks: knob grids {:.1} s, forward selection {:.1} s, explanations and intervals {:.1} s",
         timing.walks, timing.grid_s, timing.select_s, timing.report_s
@@ -635,7 +633,7 @@ fn diagnose(a: &DiagnoseArgs) -> anyhow::Result<ExitCode> {
             &set,
             &lib,
             &gap::separate::SeparateOptions::default(),
-            &|| {},
+            &Silent,
         )?,
         GapFormat::Json => Vec::new(),
     };
@@ -669,9 +667,9 @@ fn explore(a: &ExploreArgs) -> anyhow::Result<ExitCode> {
         &lib,
         &opts,
         &gap::cache::SimCache::default(),
-        &|| pb.inc(1),
+        &pb,
     )?;
-    pb.finish_and_clear();
+    pb.clear();
     print(&match a.format {
         GapFormat::Json => report::json(&e)?,
         GapFormat::Text => report::gap::exploration_md(&e),
@@ -711,9 +709,9 @@ fn benchmark(a: &BenchmarkArgs) -> anyhow::Result<ExitCode> {
     }
     let pb = indicatif::ProgressBar::new_spinner();
     pb.enable_steady_tick(std::time::Duration::from_millis(250));
-    let progress = |what: &str| pb.set_message(what.to_string());
-    progress("planning: thresholds and cases");
-    let mut plan = gap::benchmark::plan(&lib, &opts, &progress)?;
+    let pb = Progress::Spinner(pb);
+    pb.stage("planning: thresholds and cases");
+    let mut plan = gap::benchmark::plan(&lib, &opts, &pb)?;
     use gap::benchmark::KINDS;
     if let Some(bad) = a.kinds.iter().find(|k| !KINDS.contains(&k.as_str())) {
         anyhow::bail!(
@@ -725,7 +723,7 @@ fn benchmark(a: &BenchmarkArgs) -> anyhow::Result<ExitCode> {
         plan.cases.retain(|c| a.kinds.contains(&c.kind));
     }
     let rows = if a.merge.is_empty() {
-        gap::benchmark::run(&lib, &opts, &plan, a.points.as_deref(), shard, &progress)?
+        gap::benchmark::run(&lib, &opts, &plan, a.points.as_deref(), shard, &pb)?
     } else {
         let Some(target) = &a.points else {
             anyhow::bail!("--merge needs --points FILE (the merged file)");
@@ -741,7 +739,7 @@ fn benchmark(a: &BenchmarkArgs) -> anyhow::Result<ExitCode> {
         rows.sort_by(|x, y| x.key.cmp(&y.key));
         rows
     };
-    pb.finish_and_clear();
+    pb.clear();
     if shard != Shard::WHOLE {
         eprintln!(
             "shard {shard}: {} cases in {}; merge the shards with --merge to score them",

@@ -7,7 +7,7 @@ use clap::{Args, Subcommand, ValueEnum};
 use robot_survey::report;
 use robot_survey::sim::{self, ContactScaling, Design, MassLaw, WalkOptions};
 
-use super::common::{SimFormat, print};
+use super::common::{Progress, SimFormat, print};
 
 /// Largest number of sizes in one `sim scale` sweep (each is a full walk).
 const MAX_SWEEP_SIZES: usize = 1000;
@@ -236,12 +236,9 @@ fn min_torque(a: &MinTorqueArgs) -> anyhow::Result<ExitCode> {
 }
 
 fn crosscheck(a: &CrosscheckArgs) -> anyhow::Result<ExitCode> {
-    let bar = indicatif::ProgressBar::new_spinner();
-    let result = robot_survey::crosscheck::run(&a.root, &a.golden, &|what| {
-        bar.set_message(format!("running {what}"));
-        bar.tick();
-    })?;
-    bar.finish_and_clear();
+    let spinner = Progress::Spinner(indicatif::ProgressBar::new_spinner());
+    let result = robot_survey::crosscheck::run(&a.root, &a.golden, &spinner)?;
+    spinner.clear();
     print(&match a.format {
         CrosscheckFormat::Json => report::json(&result)?,
         CrosscheckFormat::Md => report::crosscheck_md(&result),
@@ -284,11 +281,9 @@ fn scale(a: &ScaleArgs) -> anyhow::Result<ExitCode> {
             .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
     );
     bar.set_message(format!("simulating {}", a.run.design));
-    let study =
-        robot_survey::study::scaling::scaling_study(&design, &a.leg_lengths, &base, &|| {
-            bar.inc(1)
-        })?;
-    bar.finish_and_clear();
+    let bar = Progress::Bar(bar);
+    let study = robot_survey::study::scaling::scaling_study(&design, &a.leg_lengths, &base, &bar)?;
+    bar.clear();
     if let Some(path) = &a.plot {
         report::plot::draw_panels(path, &report::plot::scaling_panels(&study), (1200, 520))?;
         eprintln!("wrote {}", path.display());

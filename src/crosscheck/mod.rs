@@ -15,6 +15,7 @@ use std::path::{Path, PathBuf};
 use nalgebra::{UnitQuaternion, Vector3};
 use serde::{Deserialize, Serialize};
 
+use crate::progress::Observer;
 use crate::sim::{
     Controller, Design, GRAVITY_MPS2, SimError, Simulator, State, WalkOptions, WalkReport,
     hip_frame_attitude, read_trajectory_csv, report_from_trajectory, simulate_walk,
@@ -801,11 +802,12 @@ fn number(v: Option<&serde_json::Value>) -> Option<f64> {
 
 /// Runs the project's side of every case in `golden/cases.toml` and every walk in
 /// `golden/walks/*.json`, beside Drake's and the analytic values from
-/// `golden/elementary.json`. `root` is the repository (design paths are relative to it).
+/// `golden/elementary.json`. `root` is the repository (design paths are relative to it);
+/// `progress` hears a stage ("running NAME") as each case or walk begins.
 pub fn run(
     root: &Path,
     golden: &Path,
-    progress: &dyn Fn(&str),
+    progress: &dyn Observer,
 ) -> Result<Crosscheck, CrosscheckError> {
     let cases = load_cases(&golden.join("cases.toml"))?;
     let elementary_path = golden.join("elementary.json");
@@ -819,7 +821,7 @@ pub fn run(
     };
     let mut rows = Vec::new();
     for (name, case) in &cases {
-        progress(name);
+        progress.stage(&format!("running {name}"));
         let ours = run_case(root, name, case)?;
         let theirs = &drake["cases"][name.as_str()];
         for (q, v) in &ours {
@@ -848,7 +850,7 @@ pub fn run(
             .collect();
         files.sort();
         for f in files {
-            progress(&f.display().to_string());
+            progress.stage(&format!("running {}", f.display()));
             walks.push(compare_walk(root, &f)?);
         }
     }

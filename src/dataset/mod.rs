@@ -16,6 +16,7 @@
 pub mod canonical;
 pub mod datapackage;
 pub mod problem;
+pub mod publish;
 pub mod record;
 pub mod release;
 pub mod selection;

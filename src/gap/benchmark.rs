@@ -34,6 +34,7 @@ use super::simulate::{Condition, SimMetrics, resolve};
 use super::synth::{add_noise, default_conditions, expected_trials, truth_metrics};
 use super::trials::{Measurement, Metric, Trial, TrialSet};
 use crate::checkpoint::{Shard, SweepPoint, append_to, finish_points, open_log, spec_line};
+use crate::progress::{Observer, Silent};
 use crate::regression::dist::{binomial_interval, binomial_upper_bound};
 use crate::sim::Design;
 
@@ -317,7 +318,7 @@ pub fn thresholds(
         ..DiagnoseOptions::default()
     };
     Ok(
-        diagnose_conditions(&s, conditions, lib, &opts, cache, &|_| {})?
+        diagnose_conditions(&s, conditions, lib, &opts, cache, &Silent)?
             .0
             .identifiability,
     )
@@ -401,7 +402,7 @@ fn truth_setting(
 pub fn plan(
     lib: &EffectLibrary,
     opts: &BenchmarkOptions,
-    progress: &(dyn Fn(&str) + Sync),
+    progress: &dyn Observer,
 ) -> Result<Plan, GapError> {
     let design = Design::resolve(&opts.design).map_err(|e| GapError::Sim {
         origin: opts.design.clone(),
@@ -413,7 +414,7 @@ pub fn plan(
         .map(|e| e.name.clone())
         .collect();
 
-    progress("default conditions");
+    progress.stage("default conditions");
     let main = Suite::new(
         "main",
         TrialSet {
@@ -477,11 +478,11 @@ impl Thresholds {
         opts: &BenchmarkOptions,
         main: &Suite,
         effect_names: &[String],
-        progress: &(dyn Fn(&str) + Sync),
+        progress: &dyn Observer,
     ) -> Result<Thresholds, GapError> {
         let nominal = main
             .cache
-            .get(&main.conditions, lib, &ModelSetting::nominal(), &|| {})?;
+            .get(&main.conditions, lib, &ModelSetting::nominal(), &Silent)?;
         let mut noise_for_thr: Vec<f64> = opts.noise_levels.clone();
         noise_for_thr.push(opts.pair_noise);
         noise_for_thr.sort_by(f64::total_cmp);
@@ -509,7 +510,7 @@ impl Thresholds {
                 .collect()
         };
         for &noise in &noise_for_thr {
-            progress(&format!("thresholds at {} % noise", noise * 100.0));
+            progress.stage(&format!("thresholds at {} % noise", noise * 100.0));
             if opts.calibration_off_noise == Some(noise) {
                 let off = at(noise, &opts.effects, false)?;
                 out.off.insert(format!("{noise}"), named(&off));
@@ -902,9 +903,9 @@ fn run_case(
         Truth::Sim { params, effects } => {
             let setting = truth_setting(lib, design, params, effects)?;
             if setting == ModelSetting::nominal() {
-                suite.cache.get(&suite.conditions, lib, &setting, &|| {})?
+                suite.cache.get(&suite.conditions, lib, &setting, &Silent)?
             } else {
-                truth_metrics(&suite.conditions, lib, &setting, &|| {})?
+                truth_metrics(&suite.conditions, lib, &setting, &Silent)?
             }
         }
         Truth::Drake { file, .. } => plan
@@ -937,7 +938,7 @@ fn run_case(
         ..DiagnoseOptions::default()
     };
     let walks0 = suite.cache.walks();
-    let (d, _) = diagnose_conditions(&set, &suite.conditions, lib, &opts, &suite.cache, &|_| {})?;
+    let (d, _) = diagnose_conditions(&set, &suite.conditions, lib, &opts, &suite.cache, &Silent)?;
     let knobs = |v: &[super::diagnose::Named]| {
         v.iter()
             .map(|n| n.knob.clone())
@@ -1021,7 +1022,7 @@ pub fn run(
     plan: &Plan,
     points: Option<&Path>,
     shard: Shard,
-    progress: &(dyn Fn(&str) + Sync),
+    progress: &dyn Observer,
 ) -> Result<Vec<CaseRow>, GapError> {
     let design = Design::resolve(&opts.design).map_err(|e| GapError::Sim {
         origin: opts.design.clone(),
@@ -1053,7 +1054,7 @@ pub fn run(
             };
             append_to(log.as_ref(), &row)?;
             let k = count.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1;
-            progress(&format!("{k}/{total} cases ({})", c.key));
+            progress.stage(&format!("{k}/{total} cases ({})", c.key));
             Ok(row)
         })
         .collect::<Result<_, GapError>>()?;

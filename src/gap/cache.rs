@@ -10,6 +10,7 @@ use super::error::GapError;
 use super::knob::ModelSetting;
 use super::library::EffectLibrary;
 use super::simulate::{Condition, SimMetrics, simulate_jobs};
+use crate::progress::Observer;
 
 /// Walk metrics by (condition index, setting key).
 type WalkMap = HashMap<(usize, String), SimMetrics>;
@@ -32,7 +33,7 @@ impl SimCache {
         conditions: &[Condition],
         lib: &EffectLibrary,
         setting: &ModelSetting,
-        progress: &(dyn Fn() + Sync),
+        progress: &dyn Observer,
     ) -> Result<Vec<SimMetrics>, GapError> {
         self.get_many(conditions, lib, std::slice::from_ref(setting), progress)
             .map(|mut v| v.remove(0))
@@ -45,7 +46,7 @@ impl SimCache {
         conditions: &[Condition],
         lib: &EffectLibrary,
         settings: &[ModelSetting],
-        progress: &(dyn Fn() + Sync),
+        progress: &dyn Observer,
     ) -> Result<Vec<Vec<SimMetrics>>, GapError> {
         let keys: Vec<Vec<(usize, String)>> = settings
             .iter()
@@ -98,7 +99,7 @@ impl SimCache {
         which: &[usize],
         lib: &EffectLibrary,
         setting: &ModelSetting,
-        progress: &(dyn Fn() + Sync),
+        progress: &dyn Observer,
     ) -> Result<Vec<SimMetrics>, GapError> {
         let keys: Vec<(usize, String)> = which
             .iter()

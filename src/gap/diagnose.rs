@@ -11,8 +11,6 @@
 //! point. The answer names the chain's knobs with profile intervals, checks the final
 //! residuals and says where any rest lies.
 
-use std::time::Instant;
-
 use serde::Serialize;
 
 use super::cache::SimCache;
@@ -28,6 +26,7 @@ use super::select::{SelectOptions, Step, gap_of, select, within_noise};
 use super::simulate::{Condition, resolve};
 use super::surrogate::Surrogate;
 use super::trials::{Metric, TrialSet};
+use crate::progress::{Observer, Stopwatch};
 use crate::regression::dist::chi2_upper_p;
 
 #[derive(Clone, Debug)]
@@ -322,7 +321,7 @@ pub fn diagnose(
     set: &TrialSet,
     lib: &EffectLibrary,
     opts: &DiagnoseOptions,
-    progress: &(dyn Fn(&str) + Sync),
+    progress: &dyn Observer,
 ) -> Result<(Diagnosis, Timing), GapError> {
     let conditions = resolve(set)?;
     let cache = SimCache::default();
@@ -361,13 +360,13 @@ pub fn build_surrogate(
     obs: &[Observation],
     grid_points: usize,
     cache: &SimCache,
-    progress: &(dyn Fn(&str) + Sync),
+    progress: &dyn Observer,
 ) -> Result<Surrogate, GapError> {
     let nominal = cache.get(
         conditions,
         lib,
         &super::knob::ModelSetting::nominal(),
-        &|| progress(""),
+        progress,
     )?;
     let setting_at = |k: usize, x: f64| {
         let mut point = knobs.nominal_point();
@@ -381,7 +380,7 @@ pub fn build_surrogate(
         settings.extend(nodes.iter().map(|x| setting_at(k, *x)));
         nodes_of.push(nodes);
     }
-    let sims = cache.get_many(conditions, lib, &settings, &|| progress(""))?;
+    let sims = cache.get_many(conditions, lib, &settings, progress)?;
     let mut it = sims.into_iter();
     let mut curves = Vec::new();
     for (knob, nodes) in knobs.list.iter().zip(nodes_of) {
@@ -433,9 +432,9 @@ pub fn build_surrogate(
         if wanted.is_empty() {
             break;
         }
-        progress("refining the knobs' curves where the gait changes fast");
+        progress.stage("refining the knobs' curves where the gait changes fast");
         let settings: Vec<_> = wanted.iter().map(|(k, x)| setting_at(*k, *x)).collect();
-        let sims = cache.get_many(conditions, lib, &settings, &|| progress(""))?;
+        let sims = cache.get_many(conditions, lib, &settings, progress)?;
         for ((k, x), s) in wanted.into_iter().zip(sims) {
             curves[k].insert(x, &s);
         }
@@ -455,7 +454,7 @@ pub fn diagnose_conditions(
     lib: &EffectLibrary,
     opts: &DiagnoseOptions,
     cache: &SimCache,
-    progress: &(dyn Fn(&str) + Sync),
+    progress: &dyn Observer,
 ) -> Result<(Diagnosis, Timing), GapError> {
     check_options(opts)?;
     let candidates = lib.subset(&opts.effects)?;
@@ -471,8 +470,8 @@ pub fn diagnose_conditions(
     let mut timing = Timing::default();
     let n = obs.len();
 
-    let t0 = Instant::now();
-    progress("walking every knob over its range");
+    let grid = Stopwatch::start();
+    progress.stage("walking every knob over its range");
     let surrogate = build_surrogate(
         conditions,
         lib,
@@ -482,7 +481,7 @@ pub fn diagnose_conditions(
         cache,
         progress,
     )?;
-    timing.grid_s = t0.elapsed().as_secs_f64();
+    timing.grid_s = grid.seconds();
     let surrogate = std::sync::RwLock::new(surrogate);
     let ctx = FitContext {
         conditions,
@@ -499,7 +498,7 @@ pub fn diagnose_conditions(
     let p_value_before = chi2_upper_p(chi2_before, n as f64).unwrap_or(1.0);
     let nominal_within_noise = p_value_before >= opts.alpha;
 
-    let t1 = Instant::now();
+    let selecting = Stopwatch::start();
     let sel_opts = SelectOptions {
         alpha: opts.alpha,
         always_recalibrate: opts.explanations,
@@ -508,15 +507,15 @@ pub fn diagnose_conditions(
     let groups = groupings(conditions);
     let labels: Vec<String> = set.trials.iter().map(|t| t.name()).collect();
     let selection = select(&ctx, &sel_opts, &nominal, &groups, &labels)?;
-    timing.select_s = t1.elapsed().as_secs_f64();
+    timing.select_s = selecting.seconds();
 
-    let t2 = Instant::now();
-    progress("intervals and competing explanations");
+    let reporting = Stopwatch::start();
+    progress.stage("intervals and competing explanations");
     let single = single_fits(&ctx, &nominal, &selection.singles);
     let final_fit = if selection.final_fit.active.is_empty() {
         selection.final_fit.clone()
     } else {
-        progress("polishing the answer with walks");
+        progress.stage("polishing the answer with walks");
         ctx.polish(&selection.final_fit)?
     };
     let (explanations, calibration) = if opts.explanations {
@@ -557,7 +556,7 @@ pub fn diagnose_conditions(
             opts.default_relative_sd * 100.0
         ));
     }
-    timing.report_s = t2.elapsed().as_secs_f64();
+    timing.report_s = reporting.seconds();
     let walks = cache.walks() - walks0;
     timing.walks = walks;
     timing.nominal_s = 0.0;
@@ -615,7 +614,7 @@ fn effect_thresholds(ctx: &FitContext<'_>, alpha: f64) -> Result<Vec<Identifiabi
         .filter(|k| k.kind == KnobKind::Effect)
         .count()
         .max(1) as f64;
-    (ctx.progress)("identifiability thresholds");
+    ctx.progress.stage("identifiability thresholds");
     identifiability(ctx, alpha / k, &|name: &str| match ctx.lib.get(name) {
         Ok(def) => (def.magnitude().name.clone(), def.magnitude().unit.clone()),
         Err(_) => (String::new(), String::new()),

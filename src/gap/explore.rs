@@ -23,6 +23,7 @@ use super::library::EffectLibrary;
 use super::problem::{Observation, chi2_of};
 use super::simulate::{Condition, SimMetrics};
 use super::trials::{Metric, TrialSet};
+use crate::progress::Observer;
 use crate::regression::dist::chi2_upper_p;
 
 /// A setting is plausible when its χ² against the trials has at least this p-value.
@@ -170,7 +171,7 @@ pub fn explore(
     lib: &EffectLibrary,
     opts: &ExploreOptions,
     cache: &SimCache,
-    progress: &(dyn Fn() + Sync),
+    progress: &dyn Observer,
 ) -> Result<Exploration, GapError> {
     if opts.samples < 2 {
         return Err(GapError::Invalid("explore needs at least 2 samples".into()));

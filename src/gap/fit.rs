@@ -13,6 +13,7 @@ use super::problem::{Objective, Observation, chi2_of};
 use super::simulate::{Condition, SimMetrics};
 use super::solver::{minimize, scan, scan_minima};
 use super::surrogate::{Correction, Surrogate};
+use crate::progress::Observer;
 use crate::regression::dist::{chi2_upper_p, f_upper_p};
 
 /// Points of a one-coordinate scan (starts, profiles).
@@ -112,7 +113,7 @@ pub struct FitContext<'a> {
     /// Behind a lock: refinements add walked nodes to the knobs' curves.
     pub surrogate: &'a std::sync::RwLock<Surrogate>,
     pub obs: &'a [Observation],
-    pub progress: &'a (dyn Fn(&str) + Sync),
+    pub progress: &'a dyn Observer,
 }
 
 impl<'a> FitContext<'a> {
@@ -164,7 +165,7 @@ impl<'a> FitContext<'a> {
     pub fn walks(&self, point: &[Option<f64>]) -> Result<Vec<SimMetrics>, GapError> {
         let setting = self.knobs.setting(self.lib, point);
         self.cache
-            .get(self.conditions, self.lib, &setting, &|| (self.progress)(""))
+            .get(self.conditions, self.lib, &setting, self.progress)
     }
 
     /// The fit at a walked point: its real χ² (data + prior), per condition, and the
@@ -512,9 +513,7 @@ impl<'a> FitContext<'a> {
             .collect();
         let sims = self
             .cache
-            .get_many(self.conditions, self.lib, &settings, &|| {
-                (self.progress)("")
-            })?;
+            .get_many(self.conditions, self.lib, &settings, self.progress)?;
         let mut sur = self.surrogate.write().unwrap_or_else(|e| e.into_inner());
         for ((k, x), s) in wanted.into_iter().zip(sims) {
             sur.curves[k].insert(x, &s);

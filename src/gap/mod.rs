@@ -25,8 +25,9 @@
 //! * [`benchmark`]: the diagnosis on cases of known cause, inside and outside its library;
 //!   [`waveform_bench`]: what the logged cycles buy on the look-alike pairs.
 //!
-//! Depends on [`crate::sim`] (the simulator), [`crate::regression`] (distributions) and
-//! [`crate::checkpoint`] (the benchmark's resumable points file) only.
+//! Depends on [`crate::sim`] (the simulator), [`crate::regression`] (distributions),
+//! [`crate::checkpoint`] (the benchmark's resumable points file) and [`crate::progress`]
+//! (the observer its long runs report to) only.
 
 pub mod benchmark;
 pub mod cache;

@@ -142,7 +142,7 @@ pub fn select(
         .collect();
     // Every knob alone from the nominal: the first step's candidates, and starts for the
     // recalibration.
-    (ctx.progress)("fitting every knob alone");
+    ctx.progress.stage("fitting every knob alone");
     let singles: Vec<(usize, Fit)> = (0..knobs.len())
         .map(|c| {
             let starts = ctx.starts_adding(nominal, c);
@@ -230,7 +230,9 @@ impl Selector<'_, '_> {
         if let Some(r) = &self.recalibration {
             return Ok(r.clone());
         }
-        (self.ctx.progress)("recalibrating the nominal parameters");
+        self.ctx
+            .progress
+            .stage("recalibrating the nominal parameters");
         let r = self.ctx.with_held_out(recalibrate(
             self.ctx,
             self.nominal,
@@ -297,7 +299,7 @@ impl Selector<'_, '_> {
             return Ok(Outcome::Exhausted);
         }
         let alpha_step = self.opts.alpha / cands.len() as f64;
-        (ctx.progress)(&format!(
+        ctx.progress.stage(&format!(
             "step {}: fitting {} candidates",
             taken + 1,
             cands.len()
@@ -356,7 +358,8 @@ impl Selector<'_, '_> {
                 continue;
             }
             attempts += 1;
-            (ctx.progress)(&format!("confirming {} with walks", knob.label()));
+            ctx.progress
+                .stage(&format!("confirming {} with walks", knob.label()));
             let starts = ctx.starts_adding(current, *c);
             let real =
                 ctx.with_held_out(ctx.fit_walked(&f.active, &starts, Some(f), Some(current))?);
@@ -437,7 +440,7 @@ impl Selector<'_, '_> {
             let Some(base) = self.baseline.as_ref() else {
                 return Ok(Err("no recalibration to test against".into()));
             };
-            (ctx.progress)(&format!(
+            ctx.progress.stage(&format!(
                 "testing {} against the recalibration",
                 knob.label()
             ));
@@ -545,7 +548,7 @@ impl Selector<'_, '_> {
             .collect();
         close.sort_by(|a, b| a.1.chi2.total_cmp(&b.1.chi2));
         for (o, of) in close.into_iter().take(2) {
-            (ctx.progress)(&format!(
+            ctx.progress.stage(&format!(
                 "is {} separable from {}?",
                 knob.label(),
                 knobs[*o].label()
@@ -646,7 +649,8 @@ impl Selector<'_, '_> {
         let ctx = self.ctx;
         let knobs = &ctx.knobs.list;
         let n = self.n;
-        (ctx.progress)("comparing the model with its neighbours (knobs exchanged)");
+        ctx.progress
+            .stage("comparing the model with its neighbours (knobs exchanged)");
         let phi = dispersion(current.chi2_data, n, current.k());
         let phi = if phi.is_finite() { phi } else { 1.0 };
         let margin = separable_margin() * phi;
@@ -717,7 +721,8 @@ impl Selector<'_, '_> {
         let mut walked: Vec<(Vec<usize>, Fit)> = Vec::new();
         for (set, f) in screened.into_iter().take(SWAP_WALKS) {
             let names: Vec<String> = set.iter().map(|k| knobs[*k].label()).collect();
-            (ctx.progress)(&format!("neighbour {}", names.join(" + ")));
+            ctx.progress
+                .stage(&format!("neighbour {}", names.join(" + ")));
             let starts = starts_for(&set, current);
             let real = ctx.with_held_out(ctx.fit_walked(&set, &starts, Some(&f), None)?);
             walked.push((set, real));

@@ -25,6 +25,7 @@ use super::problem::{FELL_Z2, Observation};
 use super::simulate::{Condition, SimMetrics, resolve};
 use super::trials::TrialSet;
 use super::waveform::{self, CycleSignature, Signal};
+use crate::progress::Observer;
 use crate::regression::dist::chi2_upper_p;
 
 #[derive(Clone, Debug)]
@@ -204,7 +205,7 @@ pub fn separate(
     set: &TrialSet,
     lib: &EffectLibrary,
     opts: &SeparateOptions,
-    progress: &(dyn Fn() + Sync),
+    progress: &dyn Observer,
 ) -> Result<Separation, GapError> {
     check(opts)?;
     let conditions = resolve(set)?;
@@ -288,7 +289,7 @@ pub fn separate_with(
     lib: &EffectLibrary,
     opts: &SeparateOptions,
     cache: &CycleCache,
-    progress: &(dyn Fn() + Sync),
+    progress: &dyn Observer,
 ) -> Result<Separation, GapError> {
     check(opts)?;
     let (_, obs, mut notes) = measured(set, conditions, lib, opts.default_relative_sd)?;
@@ -385,7 +386,7 @@ struct Walker<'a> {
     lib: &'a EffectLibrary,
     settle_cycles: usize,
     cache: &'a CycleCache,
-    progress: &'a (dyn Fn() + Sync),
+    progress: &'a dyn Observer,
     walks: std::sync::atomic::AtomicUsize,
 }
 
@@ -405,7 +406,7 @@ impl Walker<'_> {
             .collect::<Result<Vec<_>, _>>()?;
         self.walks
             .fetch_add(self.conditions.len(), std::sync::atomic::Ordering::Relaxed);
-        (self.progress)();
+        self.progress.tick();
         let r = Arc::new(r);
         self.cache.put(key, r.clone())?;
         Ok(r)
@@ -710,7 +711,7 @@ pub fn follow_up(
     set: &TrialSet,
     lib: &EffectLibrary,
     opts: &SeparateOptions,
-    progress: &(dyn Fn() + Sync),
+    progress: &dyn Observer,
 ) -> Result<Vec<Separation>, GapError> {
     if d.answer.ambiguous.is_empty() || set.trials.iter().all(|t| t.trajectory.is_none()) {
         return Ok(Vec::new());

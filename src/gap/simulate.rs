@@ -9,6 +9,7 @@ use super::error::GapError;
 use super::knob::ModelSetting;
 use super::library::EffectLibrary;
 use super::trials::{Metric, Trial, TrialSet};
+use crate::progress::Observer;
 use crate::sim::design::ControlSpec;
 use crate::sim::{ContactScaling, Design, MassLaw, WalkOptions, simulate_walk};
 
@@ -255,12 +256,12 @@ pub fn simulate_jobs(
     jobs: &[(usize, ModelSetting)],
     conditions: &[Condition],
     lib: &EffectLibrary,
-    progress: &(dyn Fn() + Sync),
+    progress: &dyn Observer,
 ) -> Result<Vec<SimMetrics>, GapError> {
     jobs.par_iter()
         .map(|(i, s)| {
             let r = conditions[*i].simulate(lib, s);
-            progress();
+            progress.tick();
             r
         })
         .collect()

@@ -21,6 +21,7 @@ use super::simulate::{Condition, resolve};
 use super::synth::round_sig;
 use super::trials::{Metric, Trial, TrialSet};
 use super::waveform;
+use crate::progress::Observer;
 use crate::sim::design::ControlSpec;
 
 /// The pool's levels: drive frequency (× the design's at the robot's size), servo amplitude
@@ -113,7 +114,7 @@ pub fn suggest(
     set: &TrialSet,
     lib: &EffectLibrary,
     opts: &SuggestOptions,
-    progress: &(dyn Fn() + Sync),
+    progress: &dyn Observer,
 ) -> Result<Suggestion, GapError> {
     if opts.budget == 0 || opts.budget > 50 {
         return Err(GapError::Invalid(format!(
@@ -166,7 +167,7 @@ pub fn suggest(
                 simulate_cycles(c, lib, &models[1], settle)?,
                 simulate_cycles(c, lib, &models[2], settle)?,
             ];
-            progress();
+            progress.tick();
             Ok(r)
         })
         .collect::<Result<_, GapError>>()?;
@@ -176,7 +177,7 @@ pub fn suggest(
         .map(|(c, w)| {
             let ok = is_smooth(c, w, lib, &settings, settle, relative_sd)?;
             if ok {
-                progress();
+                progress.tick();
             }
             Ok(ok)
         })

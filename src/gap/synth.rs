@@ -9,6 +9,7 @@ use super::knob::ModelSetting;
 use super::library::{EffectLibrary, EffectSetting};
 use super::simulate::{Condition, SimMetrics, resolve};
 use super::trials::{Measurement, Metric, Trial, TrialSet};
+use crate::progress::Observer;
 use crate::sim::{Design, WalkOptions, simulate_walk};
 
 /// Drive frequencies tried around the design's, as factors; the default conditions keep
@@ -277,7 +278,7 @@ pub fn synthesize(
     opts: &SynthOptions,
     conditions: Option<TrialSet>,
     command: &str,
-    progress: &(dyn Fn() + Sync),
+    progress: &dyn Observer,
 ) -> Result<TrialSet, GapError> {
     check_noise(opts.noise)?;
     let set = conditions_or_default(opts, conditions)?;
@@ -350,14 +351,14 @@ pub fn truth_metrics(
     conditions: &[Condition],
     lib: &EffectLibrary,
     setting: &ModelSetting,
-    progress: &(dyn Fn() + Sync),
+    progress: &dyn Observer,
 ) -> Result<Vec<SimMetrics>, GapError> {
     use rayon::prelude::*;
     conditions
         .par_iter()
         .map(|c| {
             let r = c.simulate(lib, setting);
-            progress();
+            progress.tick();
             r
         })
         .collect()
@@ -372,7 +373,7 @@ pub fn synthesize_logs(
     conditions: Option<TrialSet>,
     command: &str,
     sensor: SensorNoise,
-    progress: &(dyn Fn() + Sync),
+    progress: &dyn Observer,
 ) -> Result<(TrialSet, Vec<Vec<super::waveform::LogSample>>), GapError> {
     use rayon::prelude::*;
     check_noise(opts.noise)?;
@@ -383,7 +384,7 @@ pub fn synthesize_logs(
         .par_iter()
         .map(|c| {
             let r = c.walk(lib, &setting, true);
-            progress();
+            progress.tick();
             r
         })
         .collect::<Result<_, _>>()?;

@@ -519,6 +519,29 @@ mod tests {
             .collect()
     }
 
+    /// `log` with white Gaussian noise of sd `sd_deg` on every angle: Box–Muller on ChaCha8,
+    /// drawn hip, roll, pitch, yaw for each sample, the sequence `synth::add_sensor_noise`
+    /// makes for a log without torque. Made here so that these tests name no file above this
+    /// one (synth uses waveform, not the other way).
+    fn with_white_noise(log: &[LogSample], sd_deg: f64, seed: u64) -> Vec<LogSample> {
+        use rand::{Rng, SeedableRng};
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed);
+        let mut n = || {
+            let u1: f64 = 1.0 - rng.random::<f64>();
+            let u2: f64 = rng.random::<f64>();
+            (-2.0 * u1.ln()).sqrt() * (std::f64::consts::TAU * u2).cos()
+        };
+        log.iter()
+            .map(|s| LogSample {
+                hip_angle_deg: s.hip_angle_deg + sd_deg * n(),
+                roll_deg: s.roll_deg + sd_deg * n(),
+                pitch_deg: s.pitch_deg + sd_deg * n(),
+                yaw_deg: s.yaw_deg + sd_deg * n(),
+                ..*s
+            })
+            .collect()
+    }
+
     /// A known waveform: y = 2 + 10 sin 2πft + 3 cos 4πft − 1 sin 6πft gives a₀ = 2,
     /// b₁ = 10, a₂ = 3, b₃ = −1 and nothing else, exactly; yaw's linear drift is removed and
     /// its sin term kept; a constant has RMS 0.
@@ -587,14 +610,7 @@ mod tests {
     fn spread_of_white_noise_matches_least_squares_theory() {
         let hz = 1.0;
         let clean = log_of_fn(|t| (std::f64::consts::TAU * t).sin(), hz, 63.0, 200);
-        let noisy = crate::gap::synth::add_sensor_noise(
-            &clean,
-            crate::gap::synth::SensorNoise {
-                angle_deg: 0.4,
-                torque_fraction: 0.0,
-            },
-            7,
-        );
+        let noisy = with_white_noise(&clean, 0.4, 7);
         let sig = signature(&noisy, hz, 2).expect("sig");
         let hip = sig.signal(Signal::HipAngle).unwrap();
         let want = 0.4 * (2.0f64 / 200.0).sqrt();

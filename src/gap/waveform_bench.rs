@@ -17,6 +17,7 @@ use super::simulate::{Condition, SimMetrics, resolve};
 use super::synth::{SensorNoise, add_noise, add_sensor_noise, default_conditions, log_seed};
 use super::trials::TrialSet;
 use super::waveform::{self, CycleSignature};
+use crate::progress::{Observer, Silent};
 use crate::sim::TrajectorySample;
 
 #[derive(Clone, Debug)]
@@ -96,11 +97,11 @@ pub struct WaveformBench {
     pub walks: usize,
 }
 
-/// Runs the benchmark; `progress` gets a line per finished cell.
+/// Runs the benchmark; `progress` hears a stage (a line) per finished cell.
 pub fn run(
     lib: &EffectLibrary,
     opts: &WaveformBenchOptions,
-    progress: &(dyn Fn(&str) + Sync),
+    progress: &dyn Observer,
 ) -> Result<WaveformBench, GapError> {
     let base = TrialSet {
         origin: format!("default conditions of {}", opts.design),
@@ -125,7 +126,7 @@ pub fn run(
             }
         }
     }
-    progress("identification thresholds from the summaries");
+    progress.stage("identification thresholds from the summaries");
     let ids = super::benchmark::thresholds(
         &base,
         &conditions,
@@ -156,7 +157,7 @@ pub fn run(
                 confusion_at_1x: [0, 0],
             };
             let Some(th) = threshold else {
-                progress(&format!(
+                progress.stage(&format!(
                     "{truth}: no identification threshold within its range"
                 ));
                 pairs.push(summary);
@@ -190,7 +191,7 @@ pub fn run(
                 for seed in 0..opts.seeds {
                     let (set, sigs) =
                         measurement(&base, &conditions, &truth_walks, opts, seed, truth, k)?;
-                    let s = separate_with(&set, &conditions, &sigs, lib, &sep, &cache, &|| {})?;
+                    let s = separate_with(&set, &conditions, &sigs, lib, &sep, &cache, &Silent)?;
                     walks += s.walks;
                     for r in &s.rankings {
                         let m = usize::from(r.evidence == Evidence::SummariesAndWaveforms);
@@ -203,7 +204,7 @@ pub fn run(
                         }
                     }
                 }
-                progress(&format!(
+                progress.stage(&format!(
                     "{truth} ×{k} vs {rival}: correct {}/{} (summaries), {}/{} (+ waveforms)",
                     cell.correct[0], cell.seeds, cell.correct[1], cell.seeds
                 ));

@@ -9,6 +9,7 @@
 use rayon::prelude::*;
 use serde::Serialize;
 
+use crate::progress::Observer;
 use crate::regression::{self, Method};
 use crate::sim::{Design, SimError, WalkOptions, WalkReport, simulate_walk};
 
@@ -55,12 +56,12 @@ pub(crate) fn law(x: &'static str, y: &'static str, xs: &[f64], ys: &[f64]) -> O
 }
 
 /// Simulates `design` at every leg length in `leg_lengths_m` with `base` options (its
-/// `leg_length_m` is replaced), calling `on_done` after each walk (for a progress bar).
+/// `leg_length_m` is replaced), ticking `progress` after each walk.
 pub fn scaling_study(
     design: &Design,
     leg_lengths_m: &[f64],
     base: &WalkOptions,
-    on_done: &(dyn Fn() + Sync),
+    progress: &dyn Observer,
 ) -> Result<ScalingStudy, SimError> {
     let walks: Vec<WalkReport> = leg_lengths_m
         .par_iter()
@@ -71,7 +72,7 @@ pub fn scaling_study(
                 ..base.clone()
             };
             let r = simulate_walk(design, &opts).map(|w| w.report);
-            on_done();
+            progress.tick();
             r
         })
         .collect::<Result<_, _>>()?;

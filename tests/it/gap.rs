@@ -13,6 +13,7 @@ use robot_survey::gap::knob::ModelSetting;
 use robot_survey::gap::simulate::{Condition, resolve};
 use robot_survey::gap::synth::{add_noise, default_conditions, truth_metrics};
 use robot_survey::gap::{EffectLibrary, TrialSet};
+use robot_survey::progress::Silent;
 
 use super::common::{repo, stderr, stdout, survey};
 
@@ -192,7 +193,7 @@ fn synth_and_diagnose(s: &Shared, effect: Option<(&str, f64)>, seed: u64) -> Dia
         let scale = def.magnitude().scale.value(&s.conditions[0].design);
         setting.effects.push(def.setting(si / scale));
     }
-    let truth = truth_metrics(&s.conditions, &s.lib, &setting, &|| {}).expect("truth");
+    let truth = truth_metrics(&s.conditions, &s.lib, &setting, &Silent).expect("truth");
     let trials = add_noise(&s.base.trials, &truth, 0.05, seed, "test");
     let set = TrialSet {
         origin: "synthetic".into(),
@@ -205,7 +206,7 @@ fn synth_and_diagnose(s: &Shared, effect: Option<(&str, f64)>, seed: u64) -> Dia
         identifiability: false,
         ..DiagnoseOptions::default()
     };
-    diagnose_conditions(&set, &s.conditions, &s.lib, &opts, &s.cache, &|_| {})
+    diagnose_conditions(&set, &s.conditions, &s.lib, &opts, &s.cache, &Silent)
         .expect("diagnosis")
         .0
 }
@@ -382,7 +383,7 @@ fn a_trajectory_file_is_measured_like_a_walk() {
         &lib,
         &opts,
         &SimCache::default(),
-        &|_| {},
+        &Silent,
     )
     .expect("diagnosis");
     assert_eq!(

@@ -13,6 +13,7 @@ use robot_survey::gap::knob::ModelSetting;
 use robot_survey::gap::simulate::{Condition, resolve};
 use robot_survey::gap::synth::{add_noise, truth_metrics};
 use robot_survey::gap::trials::{Metric, TrialSet};
+use robot_survey::progress::Silent;
 use robot_survey::sim::Design;
 
 use super::common::{repo, stderr, stdout, survey};
@@ -65,7 +66,7 @@ fn case(
         set.nondimensional[0] = si / def.magnitude().scale.value(design);
         setting.effects.push(set);
     }
-    let truth = truth_metrics(&s.conditions, &s.lib, &setting, &|| {}).expect("truth");
+    let truth = truth_metrics(&s.conditions, &s.lib, &setting, &Silent).expect("truth");
     let set = TrialSet {
         origin: "synthetic".into(),
         base_dir: s.base.base_dir.clone(),
@@ -78,7 +79,7 @@ fn case(
         identifiability: false,
         ..DiagnoseOptions::default()
     };
-    diagnose_conditions(&set, &s.conditions, &s.lib, &opts, &s.cache, &|_| {})
+    diagnose_conditions(&set, &s.conditions, &s.lib, &opts, &s.cache, &Silent)
         .expect("diagnosis")
         .0
 }
@@ -305,7 +306,7 @@ fn a_drake_made_null_case_is_not_blamed_on_an_effect() {
         &lib,
         &opts,
         &SimCache::default(),
-        &|_| {},
+        &Silent,
     )
     .expect("diagnosis");
     assert!(!d.within_noise, "the engines differ: a real gap");

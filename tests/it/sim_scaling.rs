@@ -6,6 +6,7 @@
 //! m ∝ L² and L⁴ for m ∝ L³; attitude angles are unchanged. These are truths from
 //! outside the simulator, and they test that its scaling rules are mutually consistent.
 
+use robot_survey::progress::Silent;
 use robot_survey::sim::{ContactScaling, Design, MassLaw, WalkOptions};
 use robot_survey::study::scaling::scaling_study;
 
@@ -18,7 +19,7 @@ fn study(mass_law: MassLaw) -> robot_survey::study::scaling::ScalingStudy {
         duration_s: 15.0,
         ..WalkOptions::default()
     };
-    scaling_study(&design, &SIZES, &base, &|| {}).expect("study runs")
+    scaling_study(&design, &SIZES, &base, &Silent).expect("study runs")
 }
 
 #[test]
@@ -62,8 +63,8 @@ fn scaling_study_is_deterministic_whatever_the_thread_schedule() {
         contact_scaling: ContactScaling::FixedMaterial,
         ..WalkOptions::default()
     };
-    let a = scaling_study(&design, &SIZES, &base, &|| {}).expect("runs");
-    let b = scaling_study(&design, &SIZES, &base, &|| {}).expect("runs");
+    let a = scaling_study(&design, &SIZES, &base, &Silent).expect("runs");
+    let b = scaling_study(&design, &SIZES, &base, &Silent).expect("runs");
     let bits = |s: &robot_survey::study::scaling::ScalingStudy| {
         s.walks
             .iter()
