@@ -108,8 +108,10 @@ pub fn add_noise(
 }
 
 /// The expected trials: every value the truth's, every sd FRACTION·|value| as in
-/// [`add_noise`]. What a trial set shows on average: a cause the diagnosis cannot name
-/// from these is not identifiable from such trials at that noise, whatever the draw.
+/// [`add_noise`]. What a trial set shows on average: what the diagnosis names from these is
+/// the best it does on such trials whatever the draw. A cause it cannot name from them is
+/// either not identifiable (a simpler model fits them within noise) or missed by the search
+/// (the truth fits them exactly, the chain stops short): the answer's gap left tells which.
 pub fn expected_trials(
     conditions: &[Trial],
     truth: &[SimMetrics],
@@ -218,7 +220,7 @@ pub struct SynthOptions {
     pub noise: f64,
     pub seed: u64,
     /// Write the expected values (no noise drawn; the sd columns as with the noise): what
-    /// such trials show on average, to ask whether a cause is identifiable at all.
+    /// such trials show on average, to ask what the diagnosis can name at best.
     pub expected: bool,
 }
 
