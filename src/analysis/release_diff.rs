@@ -169,10 +169,7 @@ pub struct DatasetDiff {
 impl DatasetDiff {
     /// New problems that are errors.
     pub fn new_errors(&self) -> usize {
-        self.new_problems
-            .iter()
-            .filter(|p| p.severity == Severity::Error)
-            .count()
+        crate::dataset::problem::count(&self.new_problems, Severity::Error)
     }
     /// Table 2 entries whose exponent left its previous confidence interval.
     pub fn moved_outside(&self) -> impl Iterator<Item = &Table2Change> {

@@ -165,11 +165,8 @@ pub fn validate(a: &ValidateArgs) -> anyhow::Result<ExitCode> {
             Err(e) => (vec![e.to_problem()], "motors: not read: 1 error(s)".into()),
         }),
     };
-    let motor_errors = motors
-        .iter()
-        .flat_map(|(p, _)| p)
-        .filter(|p| p.severity == dataset::Severity::Error)
-        .count();
+    let motor_errors =
+        dataset::problem::count(motors.iter().flat_map(|(p, _)| p), dataset::Severity::Error);
     match a.format {
         TextOrJson::Text => {
             let mut text = report::validation_text(&rep);

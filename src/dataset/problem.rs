@@ -10,6 +10,14 @@ pub enum Severity {
     Warning,
 }
 
+/// How many of `problems` have this severity.
+pub fn count<'a>(problems: impl IntoIterator<Item = &'a Problem>, severity: Severity) -> usize {
+    problems
+        .into_iter()
+        .filter(|p| p.severity == severity)
+        .count()
+}
+
 /// The rule a problem breaks. Its kebab-case name is stable: tests, JSON consumers and
 /// CONTRIBUTING.md refer to it.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Serialize)]

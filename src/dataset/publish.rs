@@ -14,7 +14,7 @@ use super::release::{
     MANIFEST, Release, ReleaseFile, TABLE_CSV, TABLE_PARQUET, compile, parse_semver, sha256_hex,
 };
 use super::validate::validate;
-use super::{Dataset, DatasetError, Severity};
+use super::{Dataset, DatasetError};
 
 /// Today's date (UTC) as YYYY-MM-DD, from the system clock (civil-from-days, H. Hinnant).
 pub fn today_utc() -> String {
@@ -99,12 +99,7 @@ pub fn cut_release(
             "CHANGELOG.md has no `## {version}` entry: describe what changed before releasing"
         )));
     }
-    let report = validate(ds);
-    let errors = report
-        .problems
-        .iter()
-        .filter(|p| p.severity == Severity::Error)
-        .count();
+    let errors = validate(ds).errors();
     if errors > 0 && !allow_errors {
         return Err(DatasetError::Other(format!(
             "the live records have {errors} validation error(s); run `survey validate` and fix them first \

@@ -39,16 +39,10 @@ pub struct ValidationReport {
 
 impl ValidationReport {
     pub fn errors(&self) -> usize {
-        self.problems
-            .iter()
-            .filter(|p| p.severity == Severity::Error)
-            .count()
+        super::problem::count(&self.problems, Severity::Error)
     }
     pub fn warnings(&self) -> usize {
-        self.problems
-            .iter()
-            .filter(|p| p.severity == Severity::Warning)
-            .count()
+        super::problem::count(&self.problems, Severity::Warning)
     }
 }
 
