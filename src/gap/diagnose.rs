@@ -199,7 +199,6 @@ pub struct Diagnosis {
 /// Wall-clock breakdown (not part of the deterministic result).
 #[derive(Clone, Debug, Default, Serialize)]
 pub struct Timing {
-    pub nominal_s: f64,
     pub grid_s: f64,
     pub select_s: f64,
     pub report_s: f64,
@@ -559,7 +558,6 @@ pub fn diagnose_conditions(
     timing.report_s = reporting.seconds();
     let walks = cache.walks() - walks0;
     timing.walks = walks;
-    timing.nominal_s = 0.0;
     Ok((
         Diagnosis {
             trials: set.origin.clone(),
