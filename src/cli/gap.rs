@@ -96,11 +96,11 @@ pub struct SynthArgs {
     #[arg(long, default_value_t = 0)]
     pub seed: u64,
     /// Write the expected values: no noise drawn, the _sd columns as --noise gives them. What
-    /// such trials show on average: what `gap diagnose` names from them is its best on such
-    /// trials, whatever the draw. A cause it cannot name is either not identifiable from these
-    /// conditions at this noise (a simpler model fits within noise: gap left ≤ 1) or missed by
-    /// its search (gap left beyond noise although the truth fits exactly). (Logs, with --logs,
-    /// keep their sensor noise.)
+    /// such trials show on average: `gap diagnose`'s answer without the draw's luck either way
+    /// (a draw can mislead it where these do not). A cause it cannot name is either not
+    /// identifiable from these conditions at this noise (a simpler model fits within noise:
+    /// gap left ≤ 1) or missed by its search (gap left beyond noise although the truth fits
+    /// exactly). (Logs, with --logs, keep their sensor noise.)
     #[arg(long)]
     pub expected: bool,
     /// Output trials CSV.

@@ -108,10 +108,12 @@ pub fn add_noise(
 }
 
 /// The expected trials: every value the truth's, every sd FRACTION·|value| as in
-/// [`add_noise`]. What a trial set shows on average: what the diagnosis names from these is
-/// the best it does on such trials whatever the draw. A cause it cannot name from them is
-/// either not identifiable (a simpler model fits them within noise) or missed by the search
-/// (the truth fits them exactly, the chain stops short): the answer's gap left tells which.
+/// [`add_noise`]. What a trial set shows on average: the diagnosis' answer without the draw's
+/// luck either way (a draw can also mislead it: an undeclared mass error of +8 % is
+/// "unexplained" on its expected trials and soft ground on one 3 % draw). A cause it cannot
+/// name from them is either not identifiable (a simpler model fits them within noise) or
+/// missed by the search (the truth fits them exactly, the chain stops short): the answer's
+/// gap left tells which.
 pub fn expected_trials(
     conditions: &[Trial],
     truth: &[SimMetrics],
