@@ -549,33 +549,43 @@ impl Thresholds {
     }
 }
 
-/// A case whose trials the simulator makes; its key is the truth.
-#[allow(clippy::too_many_arguments)]
-fn sim_case(
-    suite: &str,
-    kind: &str,
+/// What the simulated cases of one kind in one suite share; each case adds a seed and its
+/// truth.
+#[derive(Clone, Copy)]
+struct Batch<'k> {
+    suite: &'k str,
+    kind: &'k str,
     noise: f64,
-    seed: u64,
     calibrate: bool,
     multiple: Option<f64>,
-    params: Vec<(String, f64)>,
-    effects: Vec<(String, f64)>,
-) -> CaseSpec {
-    let key = format!(
-        "{suite}/{kind}/{}/{}/n{noise}/s{seed}{}",
-        pairs(&effects),
-        pairs(&params),
-        if calibrate { "" } else { "/nocal" }
-    );
-    CaseSpec {
-        key,
-        suite: suite.into(),
-        kind: kind.into(),
-        noise,
-        seed,
-        calibrate,
-        multiple,
-        truth: Truth::Sim { params, effects },
+}
+
+impl Batch<'_> {
+    /// The case of `seed` whose trials the simulator makes from this truth; its key is the
+    /// truth.
+    fn case(&self, seed: u64, params: &[(String, f64)], effects: &[(String, f64)]) -> CaseSpec {
+        let key = format!(
+            "{}/{}/{}/{}/n{}/s{seed}{}",
+            self.suite,
+            self.kind,
+            pairs(effects),
+            pairs(params),
+            self.noise,
+            if self.calibrate { "" } else { "/nocal" }
+        );
+        CaseSpec {
+            key,
+            suite: self.suite.into(),
+            kind: self.kind.into(),
+            noise: self.noise,
+            seed,
+            calibrate: self.calibrate,
+            multiple: self.multiple,
+            truth: Truth::Sim {
+                params: params.to_vec(),
+                effects: effects.to_vec(),
+            },
+        }
     }
 }
 
@@ -590,23 +600,31 @@ struct Planner<'a> {
 }
 
 impl Planner<'_> {
+    /// `seeds` cases of `batch` (seeds 0, 1, …) with this truth.
+    fn push(
+        &mut self,
+        batch: Batch,
+        seeds: u64,
+        params: &[(String, f64)],
+        effects: &[(String, f64)],
+    ) {
+        self.cases
+            .extend((0..seeds).map(|seed| batch.case(seed, params, effects)));
+    }
+
     /// The main suite: nulls, single effects (and again with calibration off), pairs,
-    /// nominal-parameter errors.
+    /// compounds, nominal-parameter errors.
     fn main_cases(&mut self) {
         let opts = self.opts;
+        let main = |kind, noise, multiple| Batch {
+            suite: "main",
+            kind,
+            noise,
+            calibrate: true,
+            multiple,
+        };
         for &noise in &opts.noise_levels {
-            for seed in 0..opts.null_cases {
-                self.cases.push(sim_case(
-                    "main",
-                    "null",
-                    noise,
-                    seed,
-                    true,
-                    None,
-                    vec![],
-                    vec![],
-                ));
-            }
+            self.push(main("null", noise, None), opts.null_cases, &[], &[]);
         }
         for &noise in &opts.noise_levels {
             self.singles(noise, true);
@@ -618,18 +636,7 @@ impl Planner<'_> {
         self.compounds();
         for params in &opts.parameter_errors {
             for &noise in &opts.parameter_noise {
-                for seed in 0..opts.seeds {
-                    self.cases.push(sim_case(
-                        "main",
-                        "parameter",
-                        noise,
-                        seed,
-                        true,
-                        None,
-                        params.clone(),
-                        vec![],
-                    ));
-                }
+                self.push(main("parameter", noise, None), opts.seeds, params, &[]);
             }
         }
     }
@@ -642,25 +649,29 @@ impl Planner<'_> {
             };
             for &k in &self.opts.multiples {
                 let mag = magnitude_at(self.lib, self.design, e, t, k);
-                for seed in 0..self.opts.seeds {
-                    self.cases.push(sim_case(
-                        "main",
-                        "effect",
-                        noise,
-                        seed,
-                        calibrate,
-                        Some(k),
-                        vec![],
-                        vec![(e.clone(), mag)],
-                    ));
-                }
+                let batch = Batch {
+                    suite: "main",
+                    kind: "effect",
+                    noise,
+                    calibrate,
+                    multiple: Some(k),
+                };
+                self.push(batch, self.opts.seeds, &[], &[(e.clone(), mag)]);
             }
         }
     }
 
-    /// Every pair of effects, each at the pair multiple of its threshold.
+    /// Every pair of effects, each at the pair multiple of its threshold; and once more on
+    /// its expected trials.
     fn pairs(&mut self) {
         let opts = self.opts;
+        let batch = |kind| Batch {
+            suite: "main",
+            kind,
+            noise: opts.pair_noise,
+            calibrate: true,
+            multiple: Some(opts.pair_multiple),
+        };
         for (i, a) in self.effect_names.iter().enumerate() {
             for b in &self.effect_names[i + 1..] {
                 let (Some(ta), Some(tb)) = (
@@ -669,41 +680,12 @@ impl Planner<'_> {
                 ) else {
                     continue;
                 };
-                let mag = |e: &str| {
-                    magnitude_at(
-                        self.lib,
-                        self.design,
-                        e,
-                        if e == a { ta } else { tb },
-                        opts.pair_multiple,
-                    )
-                };
-                let effects = vec![(a.clone(), mag(a)), (b.clone(), mag(b))];
-                for seed in 0..opts.seeds {
-                    self.cases.push(sim_case(
-                        "main",
-                        "pair",
-                        opts.pair_noise,
-                        seed,
-                        true,
-                        Some(opts.pair_multiple),
-                        vec![],
-                        effects.clone(),
-                    ));
-                }
-                // The same pair without the draw: what the trials show on average.
-                let mut expected = sim_case(
-                    "main",
-                    EXPECTED_PAIR,
-                    opts.pair_noise,
-                    0,
-                    true,
-                    Some(opts.pair_multiple),
-                    vec![],
-                    effects,
-                );
-                expected.key.push_str("/expected");
-                self.cases.push(expected);
+                let mag =
+                    |e: &str, t| magnitude_at(self.lib, self.design, e, t, opts.pair_multiple);
+                let effects = [(a.clone(), mag(a, ta)), (b.clone(), mag(b, tb))];
+                self.push(batch("pair"), opts.seeds, &[], &effects);
+                // Without the draw one case says it all.
+                self.push(batch(EXPECTED_PAIR), 1, &[], &effects);
             }
         }
     }
@@ -712,24 +694,20 @@ impl Planner<'_> {
     /// threshold.
     fn compounds(&mut self) {
         let opts = self.opts;
+        let batch = Batch {
+            suite: "main",
+            kind: "compound",
+            noise: opts.pair_noise,
+            calibrate: true,
+            multiple: Some(opts.pair_multiple),
+        };
         for params in &opts.compound_errors {
             for e in self.effect_names {
                 let Some(t) = self.thr.get(opts.pair_noise, e, true) else {
                     continue;
                 };
                 let mag = magnitude_at(self.lib, self.design, e, t, opts.pair_multiple);
-                for seed in 0..opts.seeds {
-                    self.cases.push(sim_case(
-                        "main",
-                        "compound",
-                        opts.pair_noise,
-                        seed,
-                        true,
-                        Some(opts.pair_multiple),
-                        params.clone(),
-                        vec![(e.clone(), mag)],
-                    ));
-                }
+                self.push(batch, opts.seeds, params, &[(e.clone(), mag)]);
             }
         }
     }
@@ -747,49 +725,28 @@ impl Planner<'_> {
             },
         )?;
         let noise = 0.05;
-        for seed in 0..opts.one_robot_null_cases {
-            self.cases.push(sim_case(
-                "one-robot",
-                "null",
-                noise,
-                seed,
-                true,
-                None,
-                vec![],
-                vec![],
-            ));
-        }
+        let batch = |kind, multiple| Batch {
+            suite: "one-robot",
+            kind,
+            noise,
+            calibrate: true,
+            multiple,
+        };
+        self.push(batch("null", None), opts.one_robot_null_cases, &[], &[]);
         for e in self.effect_names {
             let Some(t) = self.thr.get(noise, e, true) else {
                 continue;
             };
             let mag = magnitude_at(self.lib, self.design, e, t, 2.0);
-            for seed in 0..opts.seeds {
-                self.cases.push(sim_case(
-                    "one-robot",
-                    "effect",
-                    noise,
-                    seed,
-                    true,
-                    Some(2.0),
-                    vec![],
-                    vec![(e.clone(), mag)],
-                ));
-            }
+            self.push(
+                batch("effect", Some(2.0)),
+                opts.seeds,
+                &[],
+                &[(e.clone(), mag)],
+            );
         }
         for params in &opts.parameter_errors {
-            for seed in 0..opts.seeds {
-                self.cases.push(sim_case(
-                    "one-robot",
-                    "parameter",
-                    noise,
-                    seed,
-                    true,
-                    None,
-                    params.clone(),
-                    vec![],
-                ));
-            }
+            self.push(batch("parameter", None), opts.seeds, params, &[]);
         }
         Ok(one)
     }
