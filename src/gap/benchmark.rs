@@ -1342,21 +1342,14 @@ fn compound_scores(rows: &[CaseRow], aliases: &BTreeMap<String, String>, scores:
     if c.is_empty() {
         return;
     }
-    let param_named = |r: &CaseRow| {
-        truth_params(r).iter().all(|t| {
-            split(&r.named_params)
-                .iter()
-                .any(|n| n.ends_with(&format!(":{t}")))
-        })
-    };
     let effect = c
         .iter()
         .filter(|r| names_every_truth_effect(r, aliases))
         .count();
-    let param = c.iter().filter(|r| param_named(r)).count();
+    let param = c.iter().filter(|r| names_every_truth_param(r)).count();
     let both = c
         .iter()
-        .filter(|r| names_every_truth_effect(r, aliases) && param_named(r))
+        .filter(|r| names_every_truth_effect(r, aliases) && names_every_truth_param(r))
         .count();
     let spurious = c.iter().filter(|r| names_spurious_knob(r, aliases)).count();
     for (what, k, target) in [
@@ -1372,6 +1365,14 @@ fn compound_scores(rows: &[CaseRow], aliases: &BTreeMap<String, String>, scores:
             target,
         ));
     }
+}
+
+/// Every parameter of the truth named.
+fn names_every_truth_param(r: &CaseRow) -> bool {
+    let named = split(&r.named_params);
+    truth_params(r)
+        .iter()
+        .all(|t| named.iter().any(|n| n.ends_with(&format!(":{t}"))))
 }
 
 /// The truth's parameter paths.
@@ -1416,13 +1417,7 @@ fn parameter_scores(rows: &[CaseRow], scores: &mut Vec<Score>) {
             &format!("{suite}: parameter errors in a declared parameter: the right one named"),
             declared
                 .iter()
-                .filter(|r| {
-                    truth_params(r).iter().all(|t| {
-                        split(&r.named_params)
-                            .iter()
-                            .any(|n| n.ends_with(&format!(":{t}")))
-                    })
-                })
+                .filter(|r| names_every_truth_param(r))
                 .count(),
             declared.len(),
             "high",
