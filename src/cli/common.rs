@@ -77,6 +77,17 @@ pub fn print(text: &str) {
     }
 }
 
+/// A progress bar of `len` units drawn with the indicatif `template` (its default style if
+/// the template does not parse).
+pub fn templated_bar(len: u64, template: &str) -> ProgressBar {
+    let bar = ProgressBar::new(len);
+    bar.set_style(
+        indicatif::ProgressStyle::with_template(template)
+            .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
+    );
+    bar
+}
+
 /// A library run's progress on stderr: the CLI's [`Observer`], in the three forms its
 /// commands use. Only what is shown lives here; the run decides what to report.
 pub enum Progress {

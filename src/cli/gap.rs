@@ -10,7 +10,7 @@ use robot_survey::progress::{Observer, Silent, Stopwatch};
 use robot_survey::report;
 use robot_survey::sim::Design;
 
-use super::common::{Progress, print};
+use super::common::{Progress, print, templated_bar};
 
 #[derive(Args, Debug)]
 pub struct GapArgs {
@@ -359,11 +359,7 @@ fn effects(a: &EffectsArgs) -> anyhow::Result<ExitCode> {
 
 /// A bar of `len` walks with the message `what`.
 fn bar(len: u64, what: &str) -> Progress {
-    let bar = indicatif::ProgressBar::new(len);
-    bar.set_style(
-        indicatif::ProgressStyle::with_template("{msg} [{bar:30}] {pos}/{len} walks, {elapsed}")
-            .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
-    );
+    let bar = templated_bar(len, "{msg} [{bar:30}] {pos}/{len} walks, {elapsed}");
     bar.set_message(what.to_string());
     Progress::Bar(bar)
 }

@@ -7,7 +7,7 @@ use clap::{Args, Subcommand, ValueEnum};
 use robot_survey::report;
 use robot_survey::sim::{self, ContactScaling, Design, MassLaw, WalkOptions};
 
-use super::common::{Progress, SimFormat, print};
+use super::common::{Progress, SimFormat, print, templated_bar};
 
 /// Largest number of sizes in one `sim scale` sweep (each is a full walk).
 const MAX_SWEEP_SIZES: usize = 1000;
@@ -275,10 +275,9 @@ fn scale(a: &ScaleArgs) -> anyhow::Result<ExitCode> {
     }
     let design = Design::resolve(&a.run.design)?;
     let base = a.run.options();
-    let bar = indicatif::ProgressBar::new(a.leg_lengths.len() as u64);
-    bar.set_style(
-        indicatif::ProgressStyle::with_template("{msg} [{bar:30}] {pos}/{len} sizes, {elapsed}")
-            .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
+    let bar = templated_bar(
+        a.leg_lengths.len() as u64,
+        "{msg} [{bar:30}] {pos}/{len} sizes, {elapsed}",
     );
     bar.set_message(format!("simulating {}", a.run.design));
     let bar = Progress::Bar(bar);

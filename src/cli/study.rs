@@ -11,7 +11,7 @@ use robot_survey::study::sweep::{self, Shard};
 use robot_survey::study::table3::{self, TABLE3_KIND, Table3Point};
 use robot_survey::study::{Table3Spec, run_table3};
 
-use super::common::{SimFormat, print};
+use super::common::{SimFormat, print, templated_bar};
 
 /// Which contact rules a study runs.
 #[derive(ValueEnum, Debug, Clone, Copy, Default, PartialEq, Eq)]
@@ -183,8 +183,8 @@ pub fn feet(a: &FeetArgs) -> anyhow::Result<ExitCode> {
         .enumerate()
         .filter(|(k, _)| shard.takes(*k))
         .count();
-    let bar = progress(
-        total,
+    let bar = templated_bar(
+        total as u64,
         "feet [{bar:30}] {pos}/{len} feet, {elapsed} (eta {eta})",
     );
     let run = run_feet(&spec, shard, points.as_deref(), &|_, _| bar.inc(1))?;
@@ -245,15 +245,6 @@ fn sweep_points(a: &SweepArgs, name: &str, shard: Shard) -> anyhow::Result<Optio
     Ok(points)
 }
 
-fn progress(total: usize, template: &str) -> indicatif::ProgressBar {
-    let bar = indicatif::ProgressBar::new(total as u64);
-    bar.set_style(
-        indicatif::ProgressStyle::with_template(template)
-            .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
-    );
-    bar
-}
-
 struct Bar(indicatif::ProgressBar);
 
 impl table3::Observer for Bar {
@@ -297,8 +288,8 @@ pub fn table3(a: &Table3Args) -> anyhow::Result<ExitCode> {
         .filter(|(k, _)| shard.takes(*k))
         .count()
         * spec.leg_lengths_m.len();
-    let bar = progress(
-        total,
+    let bar = templated_bar(
+        total as u64,
         "table3 [{bar:30}] {pos}/{len} sizes, {elapsed} (eta {eta}) {msg}",
     );
     let run = run_table3(&spec, shard, points.as_deref(), &Bar(bar.clone()))?;
