@@ -419,17 +419,10 @@ fn value_sources(robot: &Robot, field: &str) -> Vec<SourceRef> {
 
 /// A release cell as a record value of the field's vocabulary type.
 fn cell_value(ds: &Dataset, field: &str, text: &str) -> Value {
-    let parsed = match ds.vocab.get(field).map(|f| f.field_type) {
-        Some(FieldType::Number) => text.parse().ok().map(Value::Number),
-        Some(FieldType::Integer) => text.parse().ok().map(Value::Integer),
-        Some(FieldType::Bool) => match text {
-            "true" => Some(Value::Bool(true)),
-            "false" => Some(Value::Bool(false)),
-            _ => None,
-        },
-        _ => None,
-    };
-    parsed.unwrap_or_else(|| Value::Text(text.to_string()))
+    ds.vocab
+        .get(field)
+        .and_then(|f| Value::from_cell(f.field_type, text))
+        .unwrap_or_else(|| Value::Text(text.to_string()))
 }
 
 /// The live dataset with the release's values put back into its records (records removed
@@ -444,16 +437,7 @@ fn released_state(ds: &Dataset, before: &SurveyTable, after: &SurveyTable) -> Da
             Some((rel, r)) => (rel.clone(), r.clone()),
             None => (
                 format!("robots/{}.toml", row.id),
-                Robot {
-                    id: row.id.clone(),
-                    name: row.name.clone(),
-                    class: row.class,
-                    fit: row.fit,
-                    exclusion: row.exclusion.clone(),
-                    note: None,
-                    sources: Vec::new(),
-                    values: BTreeMap::new(),
-                },
+                row.robot(Vec::new(), BTreeMap::new()),
             ),
         };
         robot.name = row.name.clone();

@@ -146,6 +146,17 @@ pub enum Value {
 }
 
 impl Value {
+    /// A table cell (a release's text form) as a value of the field's type; None when it
+    /// does not parse as that type.
+    pub fn from_cell(field_type: FieldType, cell: &str) -> Option<Value> {
+        match field_type {
+            FieldType::Number => cell.parse::<f64>().ok().map(Value::Number),
+            FieldType::Integer => cell.parse::<i64>().ok().map(Value::Integer),
+            FieldType::Bool => cell.parse::<bool>().ok().map(Value::Bool),
+            FieldType::Text => Some(Value::Text(cell.to_string())),
+        }
+    }
+
     /// The value as a number, if it is a point number or integer.
     pub fn as_f64(&self) -> Option<f64> {
         match self {

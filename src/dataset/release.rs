@@ -10,7 +10,7 @@ use std::collections::BTreeMap;
 use serde::{Deserialize, Serialize};
 use sha2::{Digest, Sha256};
 
-use super::record::{Robot, RobotClass, Value};
+use super::record::{Datum, Robot, RobotClass, Source, Value};
 use super::vocabulary::{FieldType, Vocabulary};
 use super::{Dataset, DatasetError};
 
@@ -34,6 +34,21 @@ pub struct SurveyRow {
 }
 
 impl SurveyRow {
+    /// The record this row describes, with these sources and values (a release keeps no
+    /// note).
+    pub fn robot(&self, sources: Vec<Source>, values: BTreeMap<String, Datum>) -> Robot {
+        Robot {
+            id: self.id.clone(),
+            name: self.name.clone(),
+            class: self.class,
+            fit: self.fit,
+            exclusion: self.exclusion.clone(),
+            note: None,
+            sources,
+            values,
+        }
+    }
+
     /// A numeric cell (empty or non-numeric → None).
     pub fn number(&self, column: &str) -> Option<f64> {
         self.cells

@@ -982,13 +982,7 @@ pub fn validate_release_rows(
             let Some(cell) = row.cells.get(&f.name).filter(|c| !c.is_empty()) else {
                 continue;
             };
-            let value = match f.field_type {
-                FieldType::Number => cell.parse::<f64>().ok().map(Value::Number),
-                FieldType::Integer => cell.parse::<i64>().ok().map(Value::Integer),
-                FieldType::Bool => cell.parse::<bool>().ok().map(Value::Bool),
-                FieldType::Text => Some(Value::Text(cell.clone())),
-            };
-            let Some(value) = value else {
+            let Some(value) = Value::from_cell(f.field_type, cell) else {
                 problems.push(
                     Problem::error(
                         &file,
@@ -1006,14 +1000,8 @@ pub fn validate_release_rows(
                 Datum::new(value, vec!["release".into()], None),
             );
         }
-        let robot = Robot {
-            id: row.id.clone(),
-            name: row.name.clone(),
-            class: row.class,
-            fit: row.fit,
-            exclusion: row.exclusion.clone(),
-            note: None,
-            sources: vec![Source {
+        let robot = row.robot(
+            vec![Source {
                 key: "release".into(),
                 kind: SourceKind::Dataset,
                 url: Some(format!(
@@ -1023,7 +1011,7 @@ pub fn validate_release_rows(
                 note: None,
             }],
             values,
-        };
+        );
         let mut found = Vec::new();
         check_record(
             ds,
