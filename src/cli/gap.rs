@@ -158,6 +158,13 @@ pub struct DiagnoseArgs {
     /// until the benchmark has measured it.
     #[arg(long, default_value_t = 0, value_parser = clap::value_parser!(u8).range(0..=4))]
     pub exchange_rounds: u8,
+    /// Experimental: the joint step. When no single knob passes and the model is still
+    /// beyond noise, every pair of knobs is fitted together and the best pair is taken if
+    /// it passes a 2-dof test at α over the number of pairs and each of its knobs is
+    /// needed beside the other. Off until the benchmark has measured it: on one of four
+    /// expected-trial pairs tried it led to wrong parameters named.
+    #[arg(long)]
+    pub joint_step: bool,
 }
 
 #[derive(Args, Debug)]
@@ -607,6 +614,7 @@ fn diagnose(a: &DiagnoseArgs) -> anyhow::Result<ExitCode> {
         calibrate: !a.no_calibration,
         select: gap::select::SelectOptions {
             exchange_rounds: usize::from(a.exchange_rounds),
+            joint_step: a.joint_step,
             ..gap::select::SelectOptions::default()
         },
         ..DiagnoseOptions::default()

@@ -986,8 +986,16 @@ fn statement(
         .iter()
         .enumerate()
         .map(|(i, s)| {
+            // A joint step's second knob: the pair explains together what neither did
+            // alone, so its share is only meaningful beside the first's.
+            let together = s
+                .joint_with
+                .as_ref()
+                .filter(|_| i > 0 && steps[i - 1].joint_with.as_deref() == Some(s.knob.as_str()))
+                .map(|w| format!(" (fitted together with {w})"))
+                .unwrap_or_default();
             format!(
-                "{}{}: −{:.0} %",
+                "{}{}: −{:.0} %{together}",
                 if i > 0 { "+ " } else { "" },
                 s.knob,
                 s.shrink_pct

@@ -304,6 +304,22 @@ impl<'a> FitContext<'a> {
         out
     }
 
+    /// `fit` as a point of the larger model `active` (a superset of its knobs): the knobs it
+    /// does not free at their nominal, on the surrogate. Given to `fit_walked` as `also`, it
+    /// is walked first, so the larger model never fits worse than the smaller one it nests,
+    /// whatever its own search finds (a dozen free parameters from the recalibration's
+    /// optimum need not reach the chain's point).
+    pub fn embed(&self, fit: &Fit, active: &[usize]) -> Fit {
+        let mut point = fit.point.clone();
+        for &k in active {
+            if point[k].is_none() {
+                point[k] = Some(self.knobs.list[k].resting());
+            }
+        }
+        let unit = self.unit_of(active, &point);
+        self.surrogate_fit(active, point, unit, &fit.correction)
+    }
+
     /// The surrogate fit from starts judged with `base`'s correction (screening, no walks).
     pub fn screen(&self, active: &[usize], starts: &[(Point, Correction)], base: &Fit) -> Fit {
         let points: Vec<Point> = starts.iter().map(|(p, _)| p.clone()).collect();

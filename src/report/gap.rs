@@ -186,7 +186,7 @@ fn chain_md(o: &mut String, d: &Diagnosis) {
     for (i, s) in d.chain.iter().enumerate() {
         let _ = writeln!(
             o,
-            "{}. **{}** = {} → held-out gap {:.2} (−{:.0} % at this step, −{:.0} % in all); LR {:.1}, over-dispersion {:.2}, p = {:.1e}{}{}; {}",
+            "{}. **{}** = {} → held-out gap {:.2} (−{:.0} % at this step, −{:.0} % in all); LR {:.1}, over-dispersion {:.2}, p = {:.1e}{}{}{}; {}",
             i + 1,
             s.knob,
             sig(s.value_si),
@@ -204,6 +204,12 @@ fn chain_md(o: &mut String, d: &Diagnosis) {
             } else {
                 format!("; not separable from {}", s.not_separable_from.join(", "))
             },
+            s.joint_with
+                .as_ref()
+                .map(|w| format!(
+                    "; joint step with {w} (neither passed alone; LR and p are the pair's, 2 dof)"
+                ))
+                .unwrap_or_default(),
             if s.within_noise_after {
                 "within noise after"
             } else {

@@ -271,6 +271,50 @@ fn two_effects_at_once_are_both_named() {
     assert_eq!(d.chain.len(), 2, "{}", d.answer.statement);
 }
 
+/// The same two effects with the design's uncertain parameters free: each effect must beat
+/// the recalibration (every uncertain parameter free as a nuisance) to be called, and that
+/// larger model nests the chain's model with the parameters at their nominal values. Before
+/// the test started the larger model's search from the chain's point, a dozen-parameter
+/// search from the recalibration's optimum could end worse than the chain and block the
+/// second effect (Coulomb friction + backlash at 2× thresholds on Mugatu's expected trials:
+/// "does not beat the recalibrated nominal, LR 5.7", against an LR of 1295 for backlash added
+/// to the chain). Here both effects are named and their magnitudes recovered within 15 %
+/// (interval coverage is a rate, counted by the benchmark: on this draw the Coulomb interval
+/// [0.0301, 0.0338] N·m just misses 0.03).
+#[test]
+fn two_effects_at_once_are_both_named_with_the_parameters_free() {
+    let d = case(
+        &[],
+        &[("hip_coulomb_friction", 0.03), ("soft_ground", 4.0e6)],
+        0.03,
+        7,
+        &["hip_coulomb_friction", "hip_viscous_damping", "soft_ground"],
+        true,
+    );
+    let (params, mut effects) = names(&d);
+    effects.sort();
+    assert!(params.is_empty(), "{}", d.answer.statement);
+    assert_eq!(
+        effects,
+        vec!["hip_coulomb_friction", "soft_ground"],
+        "{}",
+        d.answer.statement
+    );
+    for (knob, truth) in [("hip_coulomb_friction", 0.03), ("soft_ground", 4.0e6)] {
+        let named = d
+            .answer
+            .effects
+            .iter()
+            .find(|n| n.knob == knob)
+            .expect("named");
+        assert!(
+            (named.value / truth - 1.0).abs() < 0.15,
+            "{knob}: {} against the truth {truth}",
+            named.value
+        );
+    }
+}
+
 /// Trials made by Drake on the reference design, no effect added (the committed golden file
 /// `tests/golden/drake/gap/trials-none.csv`, made by the command in its README), plus 3 %
 /// noise: the engines' difference must not be blamed on a physical effect.
