@@ -276,13 +276,87 @@ impl Selector<'_, '_> {
 
     /// The likelihood-ratio test of `f` against `base`: (LR, over-dispersion of `f`, p).
     fn test(&self, f: &Fit, base: &Fit) -> (f64, f64, f64) {
+        self.test_df(f, base, 1)
+    }
+
+    /// The same with `df` knobs more in `f` than in `base`.
+    fn test_df(&self, f: &Fit, base: &Fit, df: usize) -> (f64, f64, f64) {
         let lr = base.chi2 - f.chi2;
         let phi = dispersion(f.chi2_data, self.n, f.k());
         (
             lr,
             phi,
-            lr_p_value(lr, 1, phi, self.n.saturating_sub(f.k())),
+            lr_p_value(lr, df, phi, self.n.saturating_sub(f.k())),
         )
+    }
+
+    /// The rules on what `real` gains over `current`: better held out, and material (the
+    /// held-out gap shrinks by `material_shrink`, or the model is within noise after).
+    /// Ok: whether it is within noise after.
+    fn gains(&self, current: &Fit, real: &Fit) -> Result<bool, String> {
+        let n = self.n;
+        let gap_before = gap_of(current, n);
+        let gap_after = gap_of(real, n);
+        let noise_after = within_noise(real, n, self.opts.alpha);
+        if gap_after >= gap_before {
+            return Err("no better on held-out conditions once walked".into());
+        }
+        if (1.0 - gap_after / gap_before) < self.opts.material_shrink && !noise_after {
+            return Err(format!(
+                "not material: the held-out gap shrinks by {:.0} % (< {:.0} %) and the rest stays beyond noise",
+                100.0 * (1.0 - gap_after / gap_before),
+                100.0 * self.opts.material_shrink
+            ));
+        }
+        Ok(noise_after)
+    }
+
+    /// The rule "beats the recalibration" for `effects` at their values in `real`: added to
+    /// the baseline of the effect tests (every uncertain parameter free, with the effects
+    /// already called), they must be significant at `alpha`, one dof each. The larger model
+    /// is also started from `real`'s own point (`FitContext::embed`): it nests that model, so
+    /// it never fits worse than it. Ok: the p-value and the new baseline.
+    fn beats_recalibration(
+        &mut self,
+        effects: &[usize],
+        real: &Fit,
+        alpha: f64,
+    ) -> Verdict<(f64, Fit)> {
+        let ctx = self.ctx;
+        if self.baseline.is_none() {
+            self.baseline = Some(self.recalibrated()?);
+        }
+        let Some(base) = self.baseline.as_ref() else {
+            return Ok(Err("no recalibration to test against".into()));
+        };
+        ctx.progress.stage(&format!(
+            "testing {} against the recalibration",
+            self.label_set(effects)
+        ));
+        let mut active = base.active.clone();
+        active.extend_from_slice(effects);
+        // One effect: scanned from the baseline, and the baseline walked as the floor; two
+        // (the joint step): from the baseline with both at their values in `real`.
+        let (starts, floor) = match effects {
+            [e] => (ctx.starts_adding(base, *e), Some(base)),
+            _ => {
+                let mut start = base.point.clone();
+                for &e in effects {
+                    start[e] = real.point[e];
+                }
+                (vec![(start, base.correction.clone())], None)
+            }
+        };
+        let embedded = ctx.embed(real, &active);
+        let nf = ctx.fit_walked(&active, &starts, Some(&embedded), floor)?;
+        let (lr, _, p) = self.test_df(&nf, base, effects.len());
+        if p >= alpha {
+            return Ok(Err(format!(
+                "does not beat the recalibrated nominal (LR {lr:.1}, p = {p:.1e}): \
+                 a plausible error of the uncertain parameters explains it as well"
+            )));
+        }
+        Ok(Ok((p, nf)))
     }
 
     /// Forward steps from `current` until nothing passes or the step limit.
@@ -442,6 +516,14 @@ impl Selector<'_, '_> {
                 }
             }
         }
+        // The table in the screen's order, walked or not (walking appended their rows).
+        let pos = |label: &str| {
+            screened
+                .iter()
+                .position(|(c, _)| knobs[*c].label() == label)
+                .unwrap_or(usize::MAX)
+        };
+        rows.sort_by_key(|r| pos(&r.knob));
         Ok(match chosen {
             Some((mut step, real, nb)) => {
                 step.candidates = rows;
@@ -497,10 +579,7 @@ impl Selector<'_, '_> {
             set.extend([a, b]);
             set
         };
-        let p_pair = |f: &Fit| {
-            let phi = dispersion(f.chi2_data, n, f.k());
-            lr_p_value(current.chi2 - f.chi2, 2, phi, n.saturating_sub(f.k()))
-        };
+        let p_pair = |f: &Fit| self.test_df(f, current, 2).2;
         let mut screened: Vec<((usize, usize), Fit)> = pairs
             .iter()
             .map(|&pair| {
@@ -524,7 +603,8 @@ impl Selector<'_, '_> {
             walked.push((pair, real));
         }
         walked.sort_by(|a, b| a.1.chi2.total_cmp(&b.1.chi2));
-        let mut whys: Vec<String> = Vec::new();
+        // Why the best-fitting pair failed: the note when none passes.
+        let mut first_why: Option<String> = None;
         for (i, (pair, real)) in walked.iter().enumerate() {
             let name = format!("{} + {}", knobs[pair.0].label(), knobs[pair.1].label());
             match self.judge_pair(current, *pair, real, alpha_pair)? {
@@ -543,10 +623,12 @@ impl Selector<'_, '_> {
                         baseline: base,
                     }));
                 }
-                Err(why) => whys.push(format!("{name}: {why}")),
+                Err(why) => {
+                    first_why.get_or_insert(format!("{name}: {why}"));
+                }
             }
         }
-        if let Some(first) = whys.first() {
+        if let Some(first) = first_why {
             self.notes.push(format!(
                 "joint step (no single knob passed): {first}; not called"
             ));
@@ -566,26 +648,16 @@ impl Selector<'_, '_> {
         let ctx = self.ctx;
         let knobs = &ctx.knobs.list;
         let n = self.n;
-        let phi = dispersion(real.chi2_data, n, real.k());
+        let (lr, phi, p) = self.test_df(real, current, 2);
         let dof = n.saturating_sub(real.k());
-        let lr = current.chi2 - real.chi2;
-        let p = lr_p_value(lr, 2, phi, dof);
         if p >= alpha_pair {
             return Ok(Err(format!(
                 "not significant once walked (p = {p:.1e} ≥ α/pairs = {alpha_pair:.1e})"
             )));
         }
         let gap_before = gap_of(current, n);
-        let gap_after = gap_of(real, n);
-        let noise_after = within_noise(real, n, self.opts.alpha);
-        if gap_after >= gap_before {
-            return Ok(Err("no better on held-out conditions".into()));
-        }
-        if (1.0 - gap_after / gap_before) < self.opts.material_shrink && !noise_after {
-            return Ok(Err(format!(
-                "not material (held-out gap −{:.0} %)",
-                100.0 * (1.0 - gap_after / gap_before)
-            )));
+        if let Err(why) = self.gains(current, real) {
+            return Ok(Err(why));
         }
         let k = real.active.len();
         if let Some(t) = real.unit[k - 2..]
@@ -627,40 +699,13 @@ impl Selector<'_, '_> {
         let mut p_recal = None;
         let mut new_baseline = None;
         if !effects.is_empty() && !self.params.is_empty() {
-            if self.baseline.is_none() {
-                self.baseline = Some(self.recalibrated()?);
+            match self.beats_recalibration(&effects, real, alpha_pair)? {
+                Err(why) => return Ok(Err(why)),
+                Ok((p, nb)) => {
+                    p_recal = Some(p);
+                    new_baseline = Some(nb);
+                }
             }
-            let Some(base) = self.baseline.clone() else {
-                return Ok(Err("no recalibration to test against".into()));
-            };
-            let mut set = base.active.clone();
-            let mut start = base.point.clone();
-            for &e in &effects {
-                set.push(e);
-                start[e] = real.point[e];
-            }
-            let embedded = ctx.embed(real, &set);
-            let nf = ctx.fit_walked(
-                &set,
-                &[(start, base.correction.clone())],
-                Some(&embedded),
-                None,
-            )?;
-            let phi_n = dispersion(nf.chi2_data, n, nf.k());
-            let p_n = lr_p_value(
-                base.chi2 - nf.chi2,
-                effects.len(),
-                phi_n,
-                n.saturating_sub(nf.k()),
-            );
-            p_recal = Some(p_n);
-            if p_n >= alpha_pair {
-                return Ok(Err(format!(
-                    "does not beat the recalibrated nominal (p = {p_n:.1e}): a plausible \
-                     error of the uncertain parameters explains it as well"
-                )));
-            }
-            new_baseline = Some(nf);
         }
         let het = ctx.consistency(real, current, self.groupings, self.labels, phi);
         if let Some(h) = het.iter().find(|h| !h.consistent) {
@@ -720,9 +765,7 @@ impl Selector<'_, '_> {
             if of.chi2 - real.chi2 >= margin {
                 continue;
             }
-            let phi_o = dispersion(of.chi2_data, n, of.k());
-            let p_o = lr_p_value(current.chi2 - of.chi2, 2, phi_o, n.saturating_sub(of.k()));
-            if p_o >= self.opts.alpha {
+            if self.test_df(of, current, 2).2 >= self.opts.alpha {
                 continue;
             }
             let ours = [pair.0, pair.1];
@@ -772,17 +815,10 @@ impl Selector<'_, '_> {
         }
         let gap_before = gap_of(current, n);
         let gap_after = gap_of(real, n);
-        let noise_after = within_noise(real, n, self.opts.alpha);
-        if gap_after >= gap_before {
-            return Ok(Err("no better on held-out conditions once walked".into()));
-        }
-        if (1.0 - gap_after / gap_before) < self.opts.material_shrink && !noise_after {
-            return Ok(Err(format!(
-                "not material: the held-out gap shrinks by {:.0} % (< {:.0} %) and the rest stays beyond noise",
-                100.0 * (1.0 - gap_after / gap_before),
-                100.0 * self.opts.material_shrink
-            )));
-        }
+        let noise_after = match self.gains(current, real) {
+            Ok(within) => within,
+            Err(why) => return Ok(Err(why)),
+        };
         if !(0.01..=0.99).contains(&t) {
             let why = format!(
                 "fitted at the {} end of its plausible range ({:.3e} {}): the trials want more than the range allows",
@@ -797,30 +833,13 @@ impl Selector<'_, '_> {
         let mut p_recal = None;
         let mut new_baseline = None;
         if knob.kind == KnobKind::Effect && !self.params.is_empty() {
-            if self.baseline.is_none() {
-                self.baseline = Some(self.recalibrated()?);
+            match self.beats_recalibration(&[c], real, alpha_step)? {
+                Err(why) => return Ok(Err(why)),
+                Ok((p, nb)) => {
+                    p_recal = Some(p);
+                    new_baseline = Some(nb);
+                }
             }
-            let Some(base) = self.baseline.as_ref() else {
-                return Ok(Err("no recalibration to test against".into()));
-            };
-            ctx.progress.stage(&format!(
-                "testing {} against the recalibration",
-                knob.label()
-            ));
-            let starts = ctx.starts_adding(base, c);
-            let mut active = base.active.clone();
-            active.push(c);
-            let embedded = ctx.embed(real, &active);
-            let nf = ctx.fit_walked(&active, &starts, Some(&embedded), Some(base))?;
-            let (lr_n, _, p_n) = self.test(&nf, base);
-            p_recal = Some(p_n);
-            if p_n >= alpha_step {
-                return Ok(Err(format!(
-                    "does not beat the recalibrated nominal (LR {lr_n:.1}, p = {p_n:.1e}): \
-                     a plausible error of the uncertain parameters explains it as well"
-                )));
-            }
-            new_baseline = Some(nf);
         }
         let het = ctx.consistency(real, current, self.groupings, self.labels, phi_r);
         if let Some(h) = het.iter().find(|h| !h.consistent) {
