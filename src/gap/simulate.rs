@@ -162,7 +162,7 @@ impl Condition {
                 source: e,
             })?;
         if let Some(m) = self.mass_kg {
-            d.mass.total_mass_kg = m;
+            d.carrying(m);
         }
         match &mut d.control {
             ControlSpec::ServoSine {

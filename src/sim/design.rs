@@ -810,6 +810,29 @@ impl Design {
         self.mass.total_mass_kg * GRAVITY_MPS2 * self.geometry.leg_length_m
     }
 
+    /// The same robot carrying a payload (or weighing other than its file says): total mass
+    /// `mass_kg`, spread like the legs' own mass, with the hip servo's gains and the
+    /// hardstop unchanged in SI. The file gives them per m·g·L (the rule a design follows
+    /// across sizes); a payload on one robot does not stiffen its servo or its stop, so their
+    /// ratios to m·g·L fall as the mass grows.
+    pub fn carrying(&mut self, mass_kg: f64) {
+        let keep = self.mass.total_mass_kg / mass_kg;
+        self.mass.total_mass_kg = mass_kg;
+        if let ControlSpec::ServoSine {
+            kp_over_mgl,
+            kd_over_mgl_sqrt_l_over_g,
+            ..
+        } = &mut self.control
+        {
+            *kp_over_mgl *= keep;
+            *kd_over_mgl_sqrt_l_over_g *= keep;
+        }
+        if let Some(h) = &mut self.hardstop {
+            h.stiffness_over_mgl *= keep;
+            h.damping_over_mgl_sqrt_l_over_g *= keep;
+        }
+    }
+
     /// The rigid-body model, with the contact effects of `effects` applied to its contact
     /// parameters.
     pub fn model(&self) -> Model {

@@ -116,6 +116,61 @@ fn published_trials_are_valid_and_sourced() {
     resolve(&set).expect("designs resolve");
 }
 
+/// A trial's `mass_kg` is a payload on the same robot: the servo's gains and the hardstop
+/// keep their SI values. Hand-derived: the bundled Mugatu's kp = 20·m·g·L = 20 × 0.9 kg ×
+/// 9.81 m/s² × 0.153 m = 27.02 N·m/rad and kd = 2·m·g·L·√(L/g) = 0.3375 N·m·s/rad, with
+/// or without 0.27 kg more; only the mass (and so the weight on the feet) changes.
+#[test]
+fn a_payload_leaves_the_servo_and_the_hardstop_as_they_are() {
+    use robot_survey::sim::Controller;
+    let text = "label,design,leg_length_m,mass_kg,source\n\
+                bare,mugatu,0.153,,x\nloaded,mugatu,0.153,1.17,x\n";
+    let set = parse(text).expect("valid");
+    let conditions = resolve(&set).expect("resolve");
+    let lib = EffectLibrary::bundled().expect("library");
+    let designs: Vec<_> = conditions
+        .iter()
+        .map(|c| {
+            c.design_with(&lib, &ModelSetting::default())
+                .expect("design")
+        })
+        .collect();
+    let gains = |d: &robot_survey::sim::Design| match d.controller() {
+        Controller::ServoSine {
+            kp_nm_per_rad,
+            kd_nms_per_rad,
+            ..
+        } => (kp_nm_per_rad, kd_nms_per_rad),
+        other => panic!("a servo, not {other:?}"),
+    };
+    let (kp0, kd0) = gains(&designs[0]);
+    let (kp1, kd1) = gains(&designs[1]);
+    let mgl = 0.9 * 9.81 * 0.153;
+    assert!((kp0 - 20.0 * mgl).abs() < 0.01 * kp0, "kp {kp0}");
+    assert!(
+        (kd0 - 2.0 * mgl * (0.153f64 / 9.81).sqrt()).abs() < 0.01 * kd0,
+        "kd {kd0}"
+    );
+    assert!(
+        (kp1 - kp0).abs() < 1e-9 * kp0,
+        "payload changed kp: {kp0} → {kp1}"
+    );
+    assert!(
+        (kd1 - kd0).abs() < 1e-9 * kd0,
+        "payload changed kd: {kd0} → {kd1}"
+    );
+    assert!((designs[1].mass.total_mass_kg - 1.17).abs() < 1e-12);
+    let stop = |d: &robot_survey::sim::Design| {
+        d.model()
+            .hardstop
+            .map(|h| (h.stiffness_nm_per_rad, h.damping_nms_per_rad))
+            .expect("a hardstop")
+    };
+    let (k0, c0) = stop(&designs[0]);
+    let (k1, c1) = stop(&designs[1]);
+    assert!((k1 - k0).abs() < 1e-9 * k0 && (c1 - c0).abs() < 1e-9 * c0);
+}
+
 #[test]
 fn effect_list_has_every_candidate_with_ranges() {
     let o = survey(&["gap", "effects", "--format", "json"]);
