@@ -310,6 +310,11 @@ pub struct BenchmarkArgs {
     /// Noise seeds per non-null case.
     #[arg(long)]
     pub seeds: Option<u64>,
+    /// Null cases of the one-robot suite (one size; conditions varied by drive, amplitude,
+    /// payload and slope). Its single-effect and parameter-error cases run when this is > 0;
+    /// 0 leaves the suite out (--quick's default; otherwise 100).
+    #[arg(long, value_name = "N")]
+    pub one_robot_nulls: Option<u64>,
     /// Noise levels (relative sd) of the null and single-effect cases.
     #[arg(long, value_delimiter = ',')]
     pub noise: Option<Vec<f64>>,
@@ -701,6 +706,9 @@ fn benchmark(a: &BenchmarkArgs) -> anyhow::Result<ExitCode> {
     if let Some(s) = a.seeds {
         opts.seeds = s;
     }
+    if let Some(n) = a.one_robot_nulls {
+        opts.one_robot_null_cases = n;
+    }
     if let Some(n) = &a.noise {
         if let Some(bad) = n.iter().find(|x| !(**x > 0.0 && **x < 1.0)) {
             anyhow::bail!("--noise {bad}: each level must be a fraction in (0, 1)");
@@ -771,6 +779,9 @@ fn benchmark(a: &BenchmarkArgs) -> anyhow::Result<ExitCode> {
     }
     if let Some(s) = a.seeds {
         command.push_str(&format!(" --seeds {s}"));
+    }
+    if let Some(n) = a.one_robot_nulls {
+        command.push_str(&format!(" --one-robot-nulls {n}"));
     }
     if !a.effects.is_empty() {
         command.push_str(&format!(" --effects {}", a.effects.join(",")));

@@ -125,13 +125,26 @@ impl BenchmarkOptions {
                 p(&[("control.amplitude_deg", 28.75)]),
                 p(&[("mass.leg_com_forward_over_l", 0.02)]),
                 p(&[("contact.hunt_crossley_dissipation_s_per_m", 30.0)]),
+                // Undeclared in the bundled Mugatu, each with a declared or library
+                // look-alike: the lateral edge of the leg's inertia box (+30 %: roll inertia,
+                // like the declared vertical edge), the feet 2 mm forward of the hip (like the
+                // declared forward COM offset), and a stiction speed 3× the file's (the
+                // friction's regularisation: slip at low speed, like rolling resistance).
+                p(&[("mass.leg_inertia_box_over_l[1]", 0.26)]),
+                p(&[("geometry.foot_center_forward_over_l", 0.015)]),
+                p(&[("contact.stiction_speed_mps", 0.003)]),
             ],
             parameter_noise: vec![0.03, 0.05],
             drake_dir: None,
             drake_seeds: 5,
             one_robot_null_cases: 100,
             calibration_off_noise: Some(0.05),
-            compound_errors: vec![p(&[("ground.slope_deg", 1.5)])],
+            // A declared error (the unreported slope: the answer "both") and an undeclared
+            // one (the leg's lateral inertia +30 %: the effect may be named, nothing else).
+            compound_errors: vec![
+                p(&[("ground.slope_deg", 1.5)]),
+                p(&[("mass.leg_inertia_box_over_l[1]", 0.26)]),
+            ],
             effects: Vec::new(),
         }
     }
@@ -1335,35 +1348,44 @@ fn names_spurious_knob(r: &CaseRow, aliases: &BTreeMap<String, String>) -> bool 
         })
 }
 
-/// Compound cases (a declared parameter error plus an effect): the effect named, the
-/// parameter named, both, and a knob named that is in neither.
+/// Compound cases (a parameter error plus an effect). With a declared parameter: the effect
+/// named, the parameter named, both, and a knob named that is in neither. With an undeclared
+/// one (which no answer can name): the effect named, and a knob named that made none of the
+/// trials — a look-alike standing for the undeclared error.
 fn compound_scores(rows: &[CaseRow], aliases: &BTreeMap<String, String>, scores: &mut Vec<Score>) {
-    let c: Vec<&CaseRow> = rows.iter().filter(|r| r.kind == "compound").collect();
-    if c.is_empty() {
-        return;
-    }
-    let effect = c
-        .iter()
-        .filter(|r| names_every_truth_effect(r, aliases))
-        .count();
-    let param = c.iter().filter(|r| names_every_truth_param(r)).count();
-    let both = c
-        .iter()
-        .filter(|r| names_every_truth_effect(r, aliases) && names_every_truth_param(r))
-        .count();
-    let spurious = c.iter().filter(|r| names_spurious_knob(r, aliases)).count();
-    for (what, k, target) in [
-        ("the effect named", effect, "high"),
-        ("the parameter named", param, "high"),
-        ("both named (the answer \"both\")", both, "high"),
-        ("a knob in neither named", spurious, "≤ 5 %"),
-    ] {
-        scores.push(score(
-            &format!("compound (declared parameter error + effect at 2× threshold): {what}"),
-            k,
-            c.len(),
-            target,
-        ));
+    for declared in [true, false] {
+        let c: Vec<&CaseRow> = rows
+            .iter()
+            .filter(|r| r.kind == "compound" && r.truth_declared == declared)
+            .collect();
+        if c.is_empty() {
+            continue;
+        }
+        let effect = c
+            .iter()
+            .filter(|r| names_every_truth_effect(r, aliases))
+            .count();
+        let param = c.iter().filter(|r| names_every_truth_param(r)).count();
+        let both = c
+            .iter()
+            .filter(|r| names_every_truth_effect(r, aliases) && names_every_truth_param(r))
+            .count();
+        let spurious = c.iter().filter(|r| names_spurious_knob(r, aliases)).count();
+        let mut list = vec![("the effect named", effect, "high")];
+        if declared {
+            list.push(("the parameter named", param, "high"));
+            list.push(("both named (the answer \"both\")", both, "high"));
+        }
+        list.push(("a knob in neither named", spurious, "≤ 5 %"));
+        let kind = if declared { "declared" } else { "undeclared" };
+        for (what, k, target) in list {
+            scores.push(score(
+                &format!("compound ({kind} parameter error + effect at 2× threshold): {what}"),
+                k,
+                c.len(),
+                target,
+            ));
+        }
     }
 }
 

@@ -371,7 +371,9 @@ fn row(
         multiple: None,
         truth_effects: truth_effects.into(),
         truth_params: truth_params.into(),
-        truth_declared: !truth_params.is_empty() && !truth_params.starts_with("mass.total"),
+        truth_declared: !truth_params.is_empty()
+            && !truth_params.starts_with("mass.total")
+            && !truth_params.starts_with("mass.leg_inertia_box_over_l[1]"),
         answer: String::new(),
         named_effects: named_effects.into(),
         named_params: named_params.into(),
@@ -480,6 +482,24 @@ fn benchmark_scores_count_what_the_rows_say() {
         "mugatu:contact.friction_mu",
         "",
     ));
+    // Compound cases with an undeclared parameter error (nothing can name it): the effect
+    // named alone is right; a look-alike parameter beside it is a knob in neither.
+    rows.push(row(
+        "compound",
+        "hip_coulomb_friction=0.02",
+        "mass.leg_inertia_box_over_l[1]=0.26",
+        "hip_coulomb_friction",
+        "",
+        "",
+    ));
+    rows.push(row(
+        "compound",
+        "hip_coulomb_friction=0.02",
+        "mass.leg_inertia_box_over_l[1]=0.26",
+        "hip_coulomb_friction",
+        "mugatu:mass.leg_inertia_box_over_l[2]",
+        "",
+    ));
     let opts = BenchmarkOptions::standard("mugatu");
     let s = summarize(&rows, &lib, &opts, Default::default());
     let get = |what: &str| {
@@ -513,6 +533,20 @@ fn benchmark_scores_count_what_the_rows_say() {
     assert_eq!(compound("the parameter named"), (2, 3));
     assert_eq!(compound("both named"), (1, 3));
     assert_eq!(compound("a knob in neither named"), (1, 3));
+    let undeclared = |what: &str| {
+        let x = get(&format!(
+            "compound (undeclared parameter error + effect at 2× threshold): {what}"
+        ));
+        (x.k, x.n)
+    };
+    assert_eq!(undeclared("the effect named"), (2, 2));
+    assert_eq!(undeclared("a knob in neither named"), (1, 2));
+    assert!(
+        !s.scores
+            .iter()
+            .any(|x| x.what.starts_with("compound (undeclared") && x.what.contains("both")),
+        "an undeclared error cannot be named: no 'both' score"
+    );
     let cov = get("95 % intervals holding the truth");
     assert_eq!((cov.k, cov.n), (1, 1));
 }
