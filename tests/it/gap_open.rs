@@ -484,22 +484,16 @@ fn benchmark_scores_count_what_the_rows_say() {
     ));
     // Compound cases with an undeclared parameter error (nothing can name it): the effect
     // named alone is right; a look-alike parameter beside it is a knob in neither.
-    rows.push(row(
-        "compound",
-        "hip_coulomb_friction=0.02",
-        "mass.leg_inertia_box_over_l[1]=0.26",
-        "hip_coulomb_friction",
-        "",
-        "",
-    ));
-    rows.push(row(
-        "compound",
-        "hip_coulomb_friction=0.02",
-        "mass.leg_inertia_box_over_l[1]=0.26",
-        "hip_coulomb_friction",
-        "mugatu:mass.leg_inertia_box_over_l[2]",
-        "",
-    ));
+    for named_param in ["", "mugatu:mass.leg_inertia_box_over_l[2]"] {
+        rows.push(row(
+            "compound",
+            "hip_coulomb_friction=0.02",
+            "mass.leg_inertia_box_over_l[1]=0.26",
+            "hip_coulomb_friction",
+            named_param,
+            "",
+        ));
+    }
     let opts = BenchmarkOptions::standard("mugatu");
     let s = summarize(&rows, &lib, &opts, Default::default());
     let get = |what: &str| {
@@ -523,24 +517,18 @@ fn benchmark_scores_count_what_the_rows_say() {
     assert_eq!((ceiling.k, ceiling.n), (1, 2));
     let ceiling_third = get("pairs on their expected trials: a spurious");
     assert_eq!((ceiling_third.k, ceiling_third.n), (0, 2));
-    let compound = |what: &str| {
+    let compound = |kind: &str, what: &str| {
         let x = get(&format!(
-            "compound (declared parameter error + effect at 2× threshold): {what}"
+            "compound ({kind} parameter error + effect at 2× threshold): {what}"
         ));
         (x.k, x.n)
     };
-    assert_eq!(compound("the effect named"), (2, 3));
-    assert_eq!(compound("the parameter named"), (2, 3));
-    assert_eq!(compound("both named"), (1, 3));
-    assert_eq!(compound("a knob in neither named"), (1, 3));
-    let undeclared = |what: &str| {
-        let x = get(&format!(
-            "compound (undeclared parameter error + effect at 2× threshold): {what}"
-        ));
-        (x.k, x.n)
-    };
-    assert_eq!(undeclared("the effect named"), (2, 2));
-    assert_eq!(undeclared("a knob in neither named"), (1, 2));
+    assert_eq!(compound("declared", "the effect named"), (2, 3));
+    assert_eq!(compound("declared", "the parameter named"), (2, 3));
+    assert_eq!(compound("declared", "both named"), (1, 3));
+    assert_eq!(compound("declared", "a knob in neither named"), (1, 3));
+    assert_eq!(compound("undeclared", "the effect named"), (2, 2));
+    assert_eq!(compound("undeclared", "a knob in neither named"), (1, 2));
     assert!(
         !s.scores
             .iter()
