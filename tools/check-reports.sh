@@ -51,7 +51,7 @@ for f in feet.md feet.csv feet.json feet.svg; do same "$T/feet/$f" "$f"; done
 "$S" sim crosscheck --format md >"$T/cc.md" 2>/dev/null; contained "$T/cc.md" drake-crosscheck.md
 "$S" gap diagnose --trials dataset/trials/published.csv --plot "$T/gp.svg" >"$T/gp.md" 2>/dev/null
 prefix "$T/gp.md" gap-published.md; same "$T/gp.svg" gap-published.svg
-"$S" gap benchmark --design mugatu --quick --noise 0.03,0.05 --null-cases 300 \
+"$S" gap benchmark --design mugatu --quick --noise 0.03,0.05 --null-cases 300 --one-robot-nulls 100 \
   --drake tests/golden/drake/gap --merge reports/gap-benchmark.points.csv \
   --points "$T/gb.points.csv" --out "$T/gb" >/dev/null 2>&1
 prefix "$T/gb/gap-benchmark.md" gap-benchmark.md
