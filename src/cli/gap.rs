@@ -315,6 +315,11 @@ pub struct BenchmarkArgs {
     /// 0 leaves the suite out (--quick's default; otherwise 100).
     #[arg(long, value_name = "N")]
     pub one_robot_nulls: Option<u64>,
+    /// Run every case with this many rounds of the diagnosis' experimental exchange step
+    /// (`gap diagnose --exchange-rounds`), to measure it. Another benchmark: use its own
+    /// points file.
+    #[arg(long, default_value_t = 0, value_parser = clap::value_parser!(u8).range(0..=4))]
+    pub exchange_rounds: u8,
     /// Noise levels (relative sd) of the null and single-effect cases.
     #[arg(long, value_delimiter = ',')]
     pub noise: Option<Vec<f64>>,
@@ -709,6 +714,7 @@ fn benchmark(a: &BenchmarkArgs) -> anyhow::Result<ExitCode> {
     if let Some(n) = a.one_robot_nulls {
         opts.one_robot_null_cases = n;
     }
+    opts.exchange_rounds = usize::from(a.exchange_rounds);
     if let Some(n) = &a.noise {
         if let Some(bad) = n.iter().find(|x| !(**x > 0.0 && **x < 1.0)) {
             anyhow::bail!("--noise {bad}: each level must be a fraction in (0, 1)");
@@ -782,6 +788,9 @@ fn benchmark(a: &BenchmarkArgs) -> anyhow::Result<ExitCode> {
     }
     if let Some(n) = a.one_robot_nulls {
         command.push_str(&format!(" --one-robot-nulls {n}"));
+    }
+    if a.exchange_rounds > 0 {
+        command.push_str(&format!(" --exchange-rounds {}", a.exchange_rounds));
     }
     if !a.effects.is_empty() {
         command.push_str(&format!(" --effects {}", a.effects.join(",")));

@@ -30,6 +30,7 @@ use super::error::GapError;
 use super::identify::Identifiability;
 use super::knob::ModelSetting;
 use super::library::{EffectLibrary, EffectSetting};
+use super::select::SelectOptions;
 use super::simulate::{Condition, SimMetrics, resolve};
 use super::synth::{add_noise, default_conditions, expected_trials, truth_metrics};
 use super::trials::{Measurement, Metric, Trial, TrialSet};
@@ -83,6 +84,15 @@ pub struct BenchmarkOptions {
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub compound_errors: Vec<Vec<(String, f64)>>,
     pub effects: Vec<String>,
+    /// Rounds of the selection's exchange step in every case (`SelectOptions::
+    /// exchange_rounds`; 0, the diagnosis' default). Part of the points file's signature
+    /// when not 0: a run with the exchange step is another benchmark.
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub exchange_rounds: usize,
+}
+
+fn is_zero(n: &usize) -> bool {
+    *n == 0
 }
 
 impl BenchmarkOptions {
@@ -146,6 +156,7 @@ impl BenchmarkOptions {
                 p(&[("mass.leg_inertia_box_over_l[1]", 0.26)]),
             ],
             effects: Vec::new(),
+            exchange_rounds: 0,
         }
     }
 }
@@ -388,6 +399,7 @@ impl Suite {
 pub struct Plan {
     pub cases: Vec<CaseSpec>,
     pub thresholds: BTreeMap<String, Vec<(String, Option<f64>)>>,
+    exchange_rounds: usize,
     suites: Vec<Suite>,
     drake: BTreeMap<String, (TrialSet, Vec<SimMetrics>)>,
 }
@@ -469,6 +481,7 @@ pub fn plan(
     Ok(Plan {
         cases,
         thresholds: thr.table,
+        exchange_rounds: opts.exchange_rounds,
         suites,
         drake,
     })
@@ -905,6 +918,10 @@ fn run_case(
         calibrate: case.calibrate,
         explanations: false,
         identifiability: false,
+        select: SelectOptions {
+            exchange_rounds: plan.exchange_rounds,
+            ..SelectOptions::default()
+        },
         ..DiagnoseOptions::default()
     };
     let walks0 = suite.cache.walks();

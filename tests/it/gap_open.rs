@@ -644,3 +644,21 @@ fn explore_says_cannot_tell_when_its_sample_is_too_sparse() {
     let o = survey(&["gap", "explore", "--trials", t, "--samples", "16"]);
     assert!(stdout(&o).contains("**Cannot tell"), "{}", stdout(&o));
 }
+
+/// The exchange step's rounds are part of a benchmark's signature only when the run uses
+/// it: the committed points file (written without the option) stays the standard run's, and
+/// a run with the exchange step cannot be resumed into it.
+#[test]
+fn a_benchmark_with_the_exchange_step_is_another_benchmark() {
+    let mut opts = BenchmarkOptions::standard("mugatu");
+    let plain = serde_json::to_string(&opts).expect("options serialise");
+    assert!(!plain.contains("exchange_rounds"), "{plain}");
+    let committed = std::fs::read_to_string(repo().join("reports/gap-benchmark.points.csv"))
+        .expect("committed points file");
+    let header = committed.lines().next().unwrap_or_default();
+    assert!(header.contains("\"one_robot_null_cases\":100"), "{header}");
+    assert!(!header.contains("exchange_rounds"), "{header}");
+    opts.exchange_rounds = 1;
+    let with = serde_json::to_string(&opts).expect("options serialise");
+    assert!(with.contains("\"exchange_rounds\":1"), "{with}");
+}
