@@ -40,7 +40,10 @@ pub struct SelectOptions {
     /// report's table); otherwise only when an effect is tested.
     pub always_recalibrate: bool,
     /// Rounds of the exchange step after the backward pass (`Selector::swap`). 0, the
-    /// default, until the benchmark has measured it: tried on four pair cases only.
+    /// default: measured on 165 benchmark cases (reports/gap-benchmark.md, 2026-11-27) it
+    /// named both causes of 3 more pairs and removed 4 wrong names, but made one (Coulomb
+    /// friction exchanged for its look-alike, damping); on by default only after a full
+    /// benchmark run with it.
     pub exchange_rounds: usize,
     /// Experimental: when no single knob passes and the model is beyond noise, fit pairs of
     /// knobs together (`Selector::joint`). Off by default: tried on four expected-trial
