@@ -1378,22 +1378,19 @@ fn compound_scores(rows: &[CaseRow], aliases: &BTreeMap<String, String>, scores:
         if c.is_empty() {
             continue;
         }
-        let effect = c
-            .iter()
-            .filter(|r| names_every_truth_effect(r, aliases))
-            .count();
-        let param = c.iter().filter(|r| names_every_truth_param(r)).count();
-        let both = c
-            .iter()
-            .filter(|r| names_every_truth_effect(r, aliases) && names_every_truth_param(r))
-            .count();
-        let spurious = c.iter().filter(|r| names_spurious_knob(r, aliases)).count();
-        let mut list = vec![("the effect named", effect, "high")];
+        let count = |pred: &dyn Fn(&CaseRow) -> bool| c.iter().filter(|r| pred(r)).count();
+        let effect = |r: &CaseRow| names_every_truth_effect(r, aliases);
+        let mut list = vec![("the effect named", count(&effect), "high")];
+        // An undeclared error cannot be named: its parameter and "both" scores would be 0
+        // by construction.
         if declared {
-            list.push(("the parameter named", param, "high"));
-            list.push(("both named (the answer \"both\")", both, "high"));
+            let param = |r: &CaseRow| names_every_truth_param(r);
+            list.push(("the parameter named", count(&param), "high"));
+            let both = |r: &CaseRow| effect(r) && param(r);
+            list.push(("both named (the answer \"both\")", count(&both), "high"));
         }
-        list.push(("a knob in neither named", spurious, "≤ 5 %"));
+        let spurious = |r: &CaseRow| names_spurious_knob(r, aliases);
+        list.push(("a knob in neither named", count(&spurious), "≤ 5 %"));
         let kind = if declared { "declared" } else { "undeclared" };
         for (what, k, target) in list {
             scores.push(score(
