@@ -142,15 +142,7 @@ impl PointLog {
                     .map_err(|_| CheckpointError::points(path, "not UTF-8 text"))?;
                 let first = text.lines().next().unwrap_or("");
                 if first != header {
-                    return Err(CheckpointError::points(
-                        path,
-                        format!(
-                            "was written for a different study (first line differs); resume only \
-                             with the same options, or use another file.\n  file:     {}\n  expected: {}",
-                            truncate(first, 300),
-                            truncate(header, 300)
-                        ),
-                    ));
+                    return Err(other_study(path, first, header));
                 }
                 let has_header = text.lines().nth(1).is_some();
                 (parse_rows::<R>(path, text)?, has_header)
@@ -225,6 +217,39 @@ pub fn append_to<R: SweepPoint>(
             })?
             .append(point),
         None => Ok(()),
+    }
+}
+
+/// The refusal of a points file whose first line is not `header`.
+fn other_study(path: &Path, first: &str, header: &str) -> CheckpointError {
+    CheckpointError::points(
+        path,
+        format!(
+            "was written for a different study (first line differs); resume only with the same \
+             options, or use another file.\n  file:     {}\n  expected: {}",
+            truncate(first, 300),
+            truncate(header, 300)
+        ),
+    )
+}
+
+/// Whether the points file at `path` can be resumed by a study whose first line is
+/// `header` (no file, an empty one, or one of the same study): the check [`PointLog::open`]
+/// makes, for a caller to refuse early, before minutes of planning, rather than after.
+pub fn check_resumable(path: &Path, header: &str) -> Result<(), CheckpointError> {
+    let file = match File::open(path) {
+        Ok(f) => f,
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(()),
+        Err(e) => return Err(CheckpointError::io(path, e)),
+    };
+    let mut first = String::new();
+    std::io::BufRead::read_line(&mut std::io::BufReader::new(file), &mut first)
+        .map_err(|e| CheckpointError::io(path, e))?;
+    let first = first.trim_end_matches(['\n', '\r']);
+    if first.is_empty() || first == header {
+        Ok(())
+    } else {
+        Err(other_study(path, first, header))
     }
 }
 

@@ -166,6 +166,13 @@ pub struct DiagnoseArgs {
     /// expected-trial pairs tried it led to wrong parameters named.
     #[arg(long)]
     pub joint_step: bool,
+    /// Experimental: the look-ahead check. Each named knob is weighed one size up: the best
+    /// model with one knob more that keeps it against the best in which it is exchanged for
+    /// a knob significant alone (and one more added). A named knob that the second fits
+    /// better than the first by the identification distance is not named (ambiguous): a
+    /// look-alike that won the first step. It only takes names away.
+    #[arg(long)]
+    pub look_ahead: bool,
 }
 
 #[derive(Args, Debug)]
@@ -321,6 +328,10 @@ pub struct BenchmarkArgs {
     /// points file.
     #[arg(long, default_value_t = 0, value_parser = clap::value_parser!(u8).range(0..=4))]
     pub exchange_rounds: u8,
+    /// Run every case with the diagnosis' experimental look-ahead check (`gap diagnose
+    /// --look-ahead`), to measure it. Another benchmark: use its own points file.
+    #[arg(long)]
+    pub look_ahead: bool,
     /// Noise levels (relative sd) of the null and single-effect cases.
     #[arg(long, value_delimiter = ',')]
     pub noise: Option<Vec<f64>>,
@@ -626,6 +637,7 @@ fn diagnose(a: &DiagnoseArgs) -> anyhow::Result<ExitCode> {
         select: gap::select::SelectOptions {
             exchange_rounds: usize::from(a.exchange_rounds),
             joint_step: a.joint_step,
+            look_ahead: a.look_ahead,
             ..gap::select::SelectOptions::default()
         },
         ..DiagnoseOptions::default()
@@ -716,6 +728,7 @@ fn benchmark(a: &BenchmarkArgs) -> anyhow::Result<ExitCode> {
         opts.one_robot_null_cases = n;
     }
     opts.exchange_rounds = usize::from(a.exchange_rounds);
+    opts.look_ahead = a.look_ahead;
     if let Some(n) = &a.noise {
         if let Some(bad) = n.iter().find(|x| !(**x > 0.0 && **x < 1.0)) {
             anyhow::bail!("--noise {bad}: each level must be a fraction in (0, 1)");
@@ -727,6 +740,12 @@ fn benchmark(a: &BenchmarkArgs) -> anyhow::Result<ExitCode> {
     let shard = a.shard.unwrap_or(Shard::WHOLE);
     if shard != Shard::WHOLE && a.points.is_none() {
         anyhow::bail!("--shard needs --points FILE (each slice writes its own points file)");
+    }
+    // A points file of another benchmark is refused now, not after minutes of planning.
+    if a.merge.is_empty()
+        && let Some(p) = &a.points
+    {
+        robot_survey::checkpoint::check_resumable(p, &gap::benchmark::spec(&opts))?;
     }
     let pb = indicatif::ProgressBar::new_spinner();
     pb.enable_steady_tick(std::time::Duration::from_millis(250));
@@ -792,6 +811,9 @@ fn benchmark(a: &BenchmarkArgs) -> anyhow::Result<ExitCode> {
     }
     if a.exchange_rounds > 0 {
         command.push_str(&format!(" --exchange-rounds {}", a.exchange_rounds));
+    }
+    if a.look_ahead {
+        command.push_str(" --look-ahead");
     }
     if !a.effects.is_empty() {
         command.push_str(&format!(" --effects {}", a.effects.join(",")));

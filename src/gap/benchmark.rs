@@ -89,6 +89,14 @@ pub struct BenchmarkOptions {
     /// when not 0: a run with the exchange step is another benchmark.
     #[serde(default, skip_serializing_if = "is_zero")]
     pub exchange_rounds: usize,
+    /// Every case with the selection's look-ahead check (`SelectOptions::look_ahead`; off,
+    /// the diagnosis' default). Part of the signature when on: another benchmark.
+    #[serde(default, skip_serializing_if = "is_false")]
+    pub look_ahead: bool,
+}
+
+fn is_false(b: &bool) -> bool {
+    !*b
 }
 
 fn is_zero(n: &usize) -> bool {
@@ -157,6 +165,7 @@ impl BenchmarkOptions {
             ],
             effects: Vec::new(),
             exchange_rounds: 0,
+            look_ahead: false,
         }
     }
 }
@@ -400,6 +409,7 @@ pub struct Plan {
     pub cases: Vec<CaseSpec>,
     pub thresholds: BTreeMap<String, Vec<(String, Option<f64>)>>,
     exchange_rounds: usize,
+    look_ahead: bool,
     suites: Vec<Suite>,
     drake: BTreeMap<String, (TrialSet, Vec<SimMetrics>)>,
 }
@@ -482,6 +492,7 @@ pub fn plan(
         cases,
         thresholds: thr.table,
         exchange_rounds: opts.exchange_rounds,
+        look_ahead: opts.look_ahead,
         suites,
         drake,
     })
@@ -920,6 +931,7 @@ fn run_case(
         identifiability: false,
         select: SelectOptions {
             exchange_rounds: plan.exchange_rounds,
+            look_ahead: plan.look_ahead,
             ..SelectOptions::default()
         },
         ..DiagnoseOptions::default()
