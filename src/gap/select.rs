@@ -1290,11 +1290,9 @@ impl Selector<'_, '_> {
             return Ok(());
         };
         // The larger model nests the answer: never worse than it, whatever its search found.
-        let (ref_chi2, ref_held) = if reference.chi2 < current.chi2 {
-            (reference.chi2, reference.held_out)
-        } else {
-            (current.chi2, current.held_out)
-        };
+        // Its held-out χ² (a dozen refits) only once an alternative beats it.
+        let mut reference = (reference.chi2 < current.chi2).then_some(reference);
+        let ref_chi2 = reference.as_ref().map_or(current.chi2, |r| r.chi2);
         let rivals: Vec<usize> = outside
             .iter()
             .copied()
@@ -1324,10 +1322,20 @@ impl Selector<'_, '_> {
                 continue;
             };
             let in_range = alt.unit.iter().all(|t| (0.01..=0.99).contains(t));
-            let better = alt.chi2 < ref_chi2 - margin
-                && alt.held_out.unwrap_or(f64::INFINITY) < ref_held.unwrap_or(f64::INFINITY)
-                && in_range;
-            if !better {
+            if !(alt.chi2 < ref_chi2 - margin && in_range) {
+                continue;
+            }
+            let ref_held = match reference.take() {
+                Some(r) => {
+                    let r = ctx.with_held_out(r);
+                    let held = r.held_out;
+                    reference = Some(r);
+                    held
+                }
+                None => current.held_out,
+            };
+            let alt = ctx.with_held_out(alt);
+            if alt.held_out.unwrap_or(f64::INFINITY) >= ref_held.unwrap_or(f64::INFINITY) {
                 continue;
             }
             let r = set
@@ -1353,7 +1361,7 @@ impl Selector<'_, '_> {
     }
 
     /// The best of `sets` (knob sets near `from`): each screened on the surrogate, the best
-    /// `take` by χ² confirmed with walks; the best walked, with its held-out χ².
+    /// `take` by χ² confirmed with walks; the best walked (without its held-out χ²).
     fn best_walked(
         &self,
         sets: Vec<Vec<usize>>,
@@ -1375,7 +1383,7 @@ impl Selector<'_, '_> {
             ctx.progress
                 .stage(&format!("look-ahead model {}", self.label_set(&set)));
             let starts = self.starts_for_set(&set, from);
-            let real = ctx.with_held_out(ctx.fit_walked(&set, &starts, Some(&f), None)?);
+            let real = ctx.fit_walked(&set, &starts, Some(&f), None)?;
             if best.as_ref().is_none_or(|(_, b)| real.chi2 < b.chi2) {
                 best = Some((set, real));
             }
