@@ -104,6 +104,16 @@ fn is_zero(n: &usize) -> bool {
 }
 
 impl BenchmarkOptions {
+    /// The selection's options of every case: the default ones plus the experimental rules
+    /// this run measures.
+    fn select_options(&self) -> SelectOptions {
+        SelectOptions {
+            exchange_rounds: self.exchange_rounds,
+            look_ahead: self.look_ahead,
+            ..SelectOptions::default()
+        }
+    }
+
     /// The benchmark for a design (the bundled Mugatu's parameter errors).
     pub fn standard(design: &str) -> BenchmarkOptions {
         let p = |v: &[(&str, f64)]| -> Vec<(String, f64)> {
@@ -408,8 +418,8 @@ impl Suite {
 pub struct Plan {
     pub cases: Vec<CaseSpec>,
     pub thresholds: BTreeMap<String, Vec<(String, Option<f64>)>>,
-    exchange_rounds: usize,
-    look_ahead: bool,
+    /// The selection's options of every case (the experimental rules the run asks for).
+    select: SelectOptions,
     suites: Vec<Suite>,
     drake: BTreeMap<String, (TrialSet, Vec<SimMetrics>)>,
 }
@@ -491,8 +501,7 @@ pub fn plan(
     Ok(Plan {
         cases,
         thresholds: thr.table,
-        exchange_rounds: opts.exchange_rounds,
-        look_ahead: opts.look_ahead,
+        select: opts.select_options(),
         suites,
         drake,
     })
@@ -929,11 +938,7 @@ fn run_case(
         calibrate: case.calibrate,
         explanations: false,
         identifiability: false,
-        select: SelectOptions {
-            exchange_rounds: plan.exchange_rounds,
-            look_ahead: plan.look_ahead,
-            ..SelectOptions::default()
-        },
+        select: plan.select.clone(),
         ..DiagnoseOptions::default()
     };
     let walks0 = suite.cache.walks();

@@ -1103,31 +1103,18 @@ impl Selector<'_, '_> {
         }
         // Screened with the surrogate correction measured at the current model (the
         // surrogate's bias near the answer), the current model the same way.
-        let starts_for = |set: &[usize], from: &Fit| self.starts_for_set(set, from);
         let own = ctx.screen(
             &current.active,
             &[(current.point.clone(), current.correction.clone())],
             current,
         );
-        let mut screened: Vec<(Vec<usize>, Fit)> = neighbours
+        let mut screened = self.screen_sets(neighbours, current);
+        screened.retain(|(_, f)| f.chi2 < own.chi2 + 2.0 * margin);
+        let mut walked: Vec<(Vec<usize>, Fit)> = self
+            .walk_sets(screened, current, SWAP_WALKS, "neighbour")?
             .into_iter()
-            .map(|set| {
-                let starts = starts_for(&set, current);
-                let f = ctx.screen(&set, &starts, current);
-                (set, f)
-            })
-            .filter(|(_, f)| f.chi2 < own.chi2 + 2.0 * margin)
+            .map(|(set, f)| (set, ctx.with_held_out(f)))
             .collect();
-        screened.sort_by(|a, b| a.1.chi2.total_cmp(&b.1.chi2));
-        let mut walked: Vec<(Vec<usize>, Fit)> = Vec::new();
-        for (set, f) in screened.into_iter().take(SWAP_WALKS) {
-            let names: Vec<String> = set.iter().map(|k| knobs[*k].label()).collect();
-            ctx.progress
-                .stage(&format!("neighbour {}", names.join(" + ")));
-            let starts = starts_for(&set, current);
-            let real = ctx.with_held_out(ctx.fit_walked(&set, &starts, Some(&f), None)?);
-            walked.push((set, real));
-        }
         walked.sort_by(|a, b| a.1.chi2.total_cmp(&b.1.chi2));
         for (set, real) in &walked {
             let in_range = real.unit.iter().all(|t| (0.01..=0.99).contains(t));
@@ -1303,7 +1290,7 @@ impl Selector<'_, '_> {
                     .is_some_and(|(_, f)| self.test(f, self.nominal).2 < alpha)
             })
             .collect();
-        for &c in &current.active {
+        for (pos, &c) in current.active.iter().enumerate() {
             let label = knobs[c].label();
             let mut sets: Vec<Vec<usize>> = Vec::new();
             for &r in &rivals {
@@ -1325,24 +1312,14 @@ impl Selector<'_, '_> {
             if !(alt.chi2 < ref_chi2 - margin && in_range) {
                 continue;
             }
-            let ref_held = match reference.take() {
-                Some(r) => {
-                    let r = ctx.with_held_out(r);
-                    let held = r.held_out;
-                    reference = Some(r);
-                    held
-                }
-                None => current.held_out,
-            };
+            reference = reference.map(|r| ctx.with_held_out(r));
+            let ref_held = reference.as_ref().map_or(current.held_out, |r| r.held_out);
             let alt = ctx.with_held_out(alt);
             if alt.held_out.unwrap_or(f64::INFINITY) >= ref_held.unwrap_or(f64::INFINITY) {
                 continue;
             }
-            let r = set
-                .iter()
-                .find(|k| !current.active.contains(k) && rivals.contains(k))
-                .map(|k| knobs[*k].label());
-            let Some(r) = r else { continue };
+            // The rival stands where `c` stood in the alternative's set.
+            let r = knobs[set[pos]].label();
             self.notes.push(format!(
                 "{} fits these trials better than any model of that size that keeps {label} \
                  (χ² {:.1} vs {:.1}, identification distance {margin:.1}): {label} is not \
@@ -1360,35 +1337,54 @@ impl Selector<'_, '_> {
         Ok(())
     }
 
-    /// The best of `sets` (knob sets near `from`): each screened on the surrogate, the best
-    /// `take` by χ² confirmed with walks; the best walked (without its held-out χ²).
+    /// `sets` (knob sets near `from`) fitted on the surrogate from `from`'s point, best χ²
+    /// first.
+    fn screen_sets(&self, sets: Vec<Vec<usize>>, from: &Fit) -> Vec<(Vec<usize>, Fit)> {
+        let mut screened: Vec<(Vec<usize>, Fit)> = sets
+            .into_iter()
+            .map(|set| {
+                let starts = self.starts_for_set(&set, from);
+                let f = self.ctx.screen(&set, &starts, from);
+                (set, f)
+            })
+            .collect();
+        screened.sort_by(|a, b| a.1.chi2.total_cmp(&b.1.chi2));
+        screened
+    }
+
+    /// The first `take` of `screened` confirmed with walks, in their order (no held-out χ²);
+    /// `what` names them in the progress line.
+    fn walk_sets(
+        &self,
+        screened: Vec<(Vec<usize>, Fit)>,
+        from: &Fit,
+        take: usize,
+        what: &str,
+    ) -> Result<Vec<(Vec<usize>, Fit)>, GapError> {
+        let ctx = self.ctx;
+        let mut walked = Vec::new();
+        for (set, f) in screened.into_iter().take(take) {
+            ctx.progress
+                .stage(&format!("{what} {}", self.label_set(&set)));
+            let starts = self.starts_for_set(&set, from);
+            let real = ctx.fit_walked(&set, &starts, Some(&f), None)?;
+            walked.push((set, real));
+        }
+        Ok(walked)
+    }
+
+    /// The best of `sets` by walked χ²: the best `take` on the surrogate, confirmed with walks.
     fn best_walked(
         &self,
         sets: Vec<Vec<usize>>,
         from: &Fit,
         take: usize,
     ) -> Result<Option<(Vec<usize>, Fit)>, GapError> {
-        let ctx = self.ctx;
-        let mut screened: Vec<(Vec<usize>, Fit)> = sets
+        let screened = self.screen_sets(sets, from);
+        Ok(self
+            .walk_sets(screened, from, take, "look-ahead model")?
             .into_iter()
-            .map(|set| {
-                let starts = self.starts_for_set(&set, from);
-                let f = ctx.screen(&set, &starts, from);
-                (set, f)
-            })
-            .collect();
-        screened.sort_by(|a, b| a.1.chi2.total_cmp(&b.1.chi2));
-        let mut best: Option<(Vec<usize>, Fit)> = None;
-        for (set, f) in screened.into_iter().take(take) {
-            ctx.progress
-                .stage(&format!("look-ahead model {}", self.label_set(&set)));
-            let starts = self.starts_for_set(&set, from);
-            let real = ctx.fit_walked(&set, &starts, Some(&f), None)?;
-            if best.as_ref().is_none_or(|(_, b)| real.chi2 < b.chi2) {
-                best = Some((set, real));
-            }
-        }
-        Ok(best)
+            .min_by(|a, b| a.1.chi2.total_cmp(&b.1.chi2)))
     }
 
     /// The chain of forward steps through exactly the knobs `set`, from the nominal, every
