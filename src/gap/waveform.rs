@@ -20,14 +20,19 @@ use super::error::GapError;
 use crate::sim::TrajectorySample;
 
 /// Harmonics kept per signal (the cycle's mean plus cos/sin of 1..=H times the drive
-/// frequency). The gaits' signals are smooth at the drive period (pitch's main component is
-/// the second harmonic, the hip torque's shape needs the third and fourth: see
-/// reports/gap-example-cycles.svg); more would add coefficients that mostly noise fills.
-pub const HARMONICS: usize = 4;
+/// frequency). The gaits' signals are mostly smooth at the drive period (pitch's main
+/// component is the second harmonic, the hip torque's shape the third and fourth: see
+/// reports/gap-example-cycles.svg), but look-alikes act in short windows: backlash
+/// delivers no torque while the lash closes after each reversal, latency shifts every
+/// edge. Measured on the waveform benchmark's latency ↔ backlash cells at 1× threshold
+/// (16 seeds each, 3 % noise, floor 5 %): 4 harmonics named 12 + 12 of 32, 8 named 13 + 15,
+/// 12 named 15 + 16 (reports/gap-benchmark.md, 2026-11-27, third session). A log needs
+/// 2H + 8 samples per cycle (Nyquist for the 12th harmonic, with room for the least squares).
+pub const HARMONICS: usize = 12;
 /// Bins of the phase-averaged cycle drawn in the figure.
 pub const FIGURE_BINS: usize = 48;
-/// Fewest samples per cycle for a cycle to count (the fit has 2H+2 unknowns).
-const MIN_SAMPLES_PER_CYCLE: usize = 16;
+/// Fewest samples per cycle for a cycle to count (the fit has 2H + 2 unknowns).
+pub const MIN_SAMPLES_PER_CYCLE: usize = 2 * HARMONICS + 8;
 /// Fewest steady cycles a signature needs (the spread needs several).
 pub const MIN_CYCLES: usize = 3;
 
@@ -366,6 +371,11 @@ pub fn signature(
             cycles.len()
         ));
     }
+    // One basis per cycle, shared by its signals (they are sampled together).
+    let bases: Vec<CycleBasis> = cycles
+        .iter()
+        .map(|(j, v)| CycleBasis::new(v.iter().map(|s| phase(s) - *j as f64)))
+        .collect();
     let mut signals = Vec::new();
     for signal in Signal::ALL {
         if log.iter().any(|s| s.get(signal).is_none()) {
@@ -373,12 +383,10 @@ pub fn signature(
         }
         let per_cycle: Vec<Vec<f64>> = cycles
             .iter()
-            .map(|(j, v)| {
-                let pts: Vec<(f64, f64)> = v
-                    .iter()
-                    .filter_map(|s| s.get(signal).map(|y| (phase(s) - *j as f64, y)))
-                    .collect();
-                fit_cycle(&pts, signal.has_trend())
+            .zip(&bases)
+            .map(|((_, v), basis)| {
+                let y: Vec<f64> = v.iter().filter_map(|s| s.get(signal)).collect();
+                basis.fit(&y, signal.has_trend())
             })
             .collect::<Option<Vec<_>>>()
             .ok_or_else(|| format!("{}: a cycle's harmonic fit is singular", signal.column()))?;
@@ -418,26 +426,59 @@ pub fn signature(
     })
 }
 
-/// Least-squares fit of one cycle's points (phase within the cycle, value) by
-/// [a₀, a₁, b₁, …, a_H, b_H] (plus a trend column whose coefficient is dropped).
-fn fit_cycle(pts: &[(f64, f64)], trend: bool) -> Option<Vec<f64>> {
-    let k = 1 + 2 * HARMONICS;
-    let cols = k + usize::from(trend);
-    let a = DMatrix::from_fn(pts.len(), cols, |r, c| {
-        let phi = pts[r].0;
-        if c == 0 {
-            1.0
-        } else if c < k {
-            let h = c.div_ceil(2) as f64;
-            let x = std::f64::consts::TAU * h * phi;
-            if c % 2 == 1 { x.cos() } else { x.sin() }
-        } else {
-            phi - 0.5
+/// The least-squares basis of one cycle's sample phases: [1, cos 2πφ, sin 2πφ, …,
+/// cos 2πHφ, sin 2πHφ, φ − ½] per sample (the last, a trend, for yaw only), with the
+/// normal equations factored once for every signal of the cycle. Hand-written rather than
+/// an SVD per signal: with 12 harmonics the SVD made the cycle fits cost more than the
+/// walks of a `gap separate` run (2× its CPU); the Fourier columns are near-orthogonal over
+/// a whole cycle, so the normal equations lose nothing, and a cycle whose Gram matrix is
+/// not positive definite falls back to the SVD.
+struct CycleBasis {
+    /// Samples × (1 + 2H + 1).
+    a: DMatrix<f64>,
+    plain: Option<nalgebra::linalg::Cholesky<f64, nalgebra::Dyn>>,
+    trend: Option<nalgebra::linalg::Cholesky<f64, nalgebra::Dyn>>,
+}
+
+impl CycleBasis {
+    fn new(phases: impl Iterator<Item = f64>) -> CycleBasis {
+        let phases: Vec<f64> = phases.collect();
+        let k = 1 + 2 * HARMONICS;
+        let mut a = DMatrix::zeros(phases.len(), k + 1);
+        for (r, &phi) in phases.iter().enumerate() {
+            let (s1, c1) = (std::f64::consts::TAU * phi).sin_cos();
+            a[(r, 0)] = 1.0;
+            // cos hx, sin hx by the angle-addition recurrence (2 trig calls per sample).
+            let (mut c, mut s) = (c1, s1);
+            for h in 1..=HARMONICS {
+                a[(r, 2 * h - 1)] = c;
+                a[(r, 2 * h)] = s;
+                (c, s) = (c * c1 - s * s1, s * c1 + c * s1);
+            }
+            a[(r, k)] = phi - 0.5;
         }
-    });
-    let y = DVector::from_iterator(pts.len(), pts.iter().map(|p| p.1));
-    let x = a.svd(true, true).solve(&y, 1e-12).ok()?;
-    Some(x.iter().take(k).copied().collect())
+        let gram = a.tr_mul(&a);
+        let plain = gram.view((0, 0), (k, k)).clone_owned().cholesky();
+        let trend = gram.cholesky();
+        CycleBasis { a, plain, trend }
+    }
+
+    /// [a₀, a₁, b₁, …, a_H, b_H] of the samples `y` (with the trend column fitted and
+    /// dropped when `trend`).
+    fn fit(&self, y: &[f64], trend: bool) -> Option<Vec<f64>> {
+        let k = 1 + 2 * HARMONICS;
+        let cols = k + usize::from(trend);
+        let a = self.a.columns(0, cols);
+        let y = DVector::from_column_slice(y);
+        let chol = if trend { &self.trend } else { &self.plain };
+        let x = match chol {
+            Some(c) => c.solve(&a.tr_mul(&y)),
+            None => a.clone_owned().svd(true, true).solve(&y, 1e-12).ok()?,
+        };
+        x.iter()
+            .all(|v| v.is_finite())
+            .then(|| x.iter().take(k).copied().collect())
+    }
 }
 
 /// The cycle of coefficients at phase `phi` (a NaN mean counts as 0).
@@ -542,9 +583,10 @@ mod tests {
             .collect()
     }
 
-    /// A known waveform: y = 2 + 10 sin 2πft + 3 cos 4πft − 1 sin 6πft gives a₀ = 2,
-    /// b₁ = 10, a₂ = 3, b₃ = −1 and nothing else, exactly; yaw's linear drift is removed and
-    /// its sin term kept; a constant has RMS 0.
+    /// A known waveform: y = 2 + 10 sin 2πft + 3 cos 4πft − 1 sin 6πft + ½ cos 20πft gives
+    /// a₀ = 2, b₁ = 10, a₂ = 3, b₃ = −1, a₁₀ = ½ and nothing else, exactly (the tenth
+    /// harmonic: the short features of backlash and latency live that high); yaw's linear
+    /// drift is removed and its sin term kept; a constant has RMS 0.
     #[test]
     fn harmonics_of_a_known_waveform() {
         let hz = 1.7;
@@ -552,17 +594,21 @@ mod tests {
         let f = |t: f64| {
             2.0 + 10.0 * (tau * hz * t).sin() + 3.0 * (2.0 * tau * hz * t).cos()
                 - (3.0 * tau * hz * t).sin()
+                + 0.5 * (10.0 * tau * hz * t).cos()
         };
         let log = log_of_fn(f, hz, 12.3, 150);
         let sig = signature(&log, hz, 2).expect("signature");
         assert_eq!(sig.cycles, 10, "cycles 2..=11; the cut 12th is dropped");
         let hip = sig.signal(Signal::HipAngle).expect("hip");
-        let want = [2.0, 0.0, 10.0, 3.0, 0.0, 0.0, -1.0, 0.0, 0.0];
-        for (c, w) in hip.coefficients.iter().zip(want) {
+        // [a₀, a₁, b₁, a₂, b₂, …]: a_h at 2h − 1, b_h at 2h.
+        let mut want = vec![0.0; 1 + 2 * HARMONICS];
+        (want[0], want[2], want[3], want[6], want[19]) = (2.0, 10.0, 3.0, -1.0, 0.5);
+        assert_eq!(hip.coefficients.len(), want.len());
+        for (c, w) in hip.coefficients.iter().zip(&want) {
             assert!((c - w).abs() < 1e-9, "{:?} vs {want:?}", hip.coefficients);
         }
-        // RMS of the AC part: √((10² + 3² + 1²)/2).
-        assert!((hip.rms - (110.0f64 / 2.0).sqrt()).abs() < 1e-9);
+        // RMS of the AC part: √((10² + 3² + 1² + ½²)/2).
+        assert!((hip.rms - (110.25f64 / 2.0).sqrt()).abs() < 1e-9);
         let yaw = sig.signal(Signal::Yaw).expect("yaw");
         assert!(yaw.coefficients[0].is_nan());
         assert!(
@@ -573,8 +619,8 @@ mod tests {
         let pitch = sig.signal(Signal::Pitch).expect("pitch");
         assert!((pitch.coefficients[0] - 1.0).abs() < 1e-12 && pitch.rms < 1e-9);
         assert!(sig.signal(Signal::HipTorque).is_none(), "no torque column");
-        // The rebuilt cycle at phase ¼: 2 + 10 − 3 + 1 = 10.
-        assert!((evaluate(&hip.coefficients, 0.25) - 10.0).abs() < 1e-9);
+        // The rebuilt cycle at phase ¼: 2 + 10 − 3 + 1 + ½·cos 5π = 9.5.
+        assert!((evaluate(&hip.coefficients, 0.25) - 9.5).abs() < 1e-9);
     }
 
     /// The drive phase column wins over f·t: a log whose clock starts 0.25 cycle late but
@@ -632,6 +678,57 @@ mod tests {
         shifted.signals[0].coefficients[2] += 2.0 * var.sqrt();
         let c = chi2(&sig, &shifted, 0.05);
         assert!((c.chi2 - 4.0).abs() < 1e-9, "{}", c.chi2);
+    }
+
+    /// The factored normal equations against an independent solver: on an irregularly
+    /// sampled stretch of a cycle (phases 0.05–0.95, jittered; 40 samples) of an arbitrary
+    /// signal, with and without the trend column, the coefficients equal nalgebra's SVD
+    /// least squares of the same design matrix (built here with direct cos/sin).
+    #[test]
+    fn cycle_fit_equals_svd_least_squares_on_irregular_samples() {
+        let phases: Vec<f64> = (0..40)
+            .map(|i| 0.05 + 0.9 * (i as f64 + 0.37 * ((i * 7 % 5) as f64 / 5.0)) / 40.0)
+            .collect();
+        let y: Vec<f64> = phases
+            .iter()
+            .map(|p| (3.0 * p).exp() + (17.0 * p).sin() + if *p > 0.6 { 1.5 } else { 0.0 })
+            .collect();
+        let basis = CycleBasis::new(phases.iter().copied());
+        let k = 1 + 2 * HARMONICS;
+        for trend in [false, true] {
+            let cols = k + usize::from(trend);
+            let a = DMatrix::from_fn(phases.len(), cols, |r, c| {
+                let phi = phases[r];
+                if c == 0 {
+                    1.0
+                } else if c < k {
+                    let x = std::f64::consts::TAU * c.div_ceil(2) as f64 * phi;
+                    if c % 2 == 1 { x.cos() } else { x.sin() }
+                } else {
+                    phi - 0.5
+                }
+            });
+            let want = a
+                .svd(true, true)
+                .solve(&DVector::from_column_slice(&y), 1e-12)
+                .expect("svd");
+            let got = basis.fit(&y, trend).expect("fit");
+            assert_eq!(got.len(), k);
+            for (g, w) in got.iter().zip(want.iter()) {
+                assert!((g - w).abs() < 1e-7 * (1.0 + w.abs()), "{got:?} vs {want:?}");
+            }
+        }
+    }
+
+    /// A log too coarse for the harmonics kept is refused with the number it needs: 30
+    /// samples per cycle against 2·12 + 8 = 32.
+    #[test]
+    fn a_log_sampled_below_the_harmonics_needs_is_refused() {
+        assert_eq!(MIN_SAMPLES_PER_CYCLE, 32);
+        let log = log_of_fn(|t| t.sin(), 1.0, 10.0, 30);
+        let e = signature(&log, 1.0, 2).expect_err("30 per cycle");
+        assert!(e.contains("at least 32 samples"), "{e}");
+        assert!(signature(&log_of_fn(|t| t.sin(), 1.0, 10.0, 32), 1.0, 2).is_ok());
     }
 
     #[test]
