@@ -166,11 +166,13 @@ pub struct DiagnoseArgs {
     /// expected-trial pairs tried it led to wrong parameters named.
     #[arg(long)]
     pub joint_step: bool,
-    /// Experimental: the look-ahead check. Each named knob is weighed one size up: the best
-    /// model with one knob more that keeps it against the best in which it is exchanged for
-    /// a knob significant alone (and one more added). A named knob that the second fits
-    /// better than the first by the identification distance is not named (ambiguous): a
-    /// look-alike that won the first step. It only takes names away.
+    /// Experimental: the look-ahead check. Each named knob is weighed at the answer's size
+    /// (the answer against the best model with that knob exchanged for another) and one
+    /// size up (the best model with one knob more that keeps it against the best in which
+    /// it is exchanged for a knob significant alone, and one more added). A named knob that
+    /// a model without it fits better than one with it by the identification distance, held
+    /// out too, is not named (ambiguous): a look-alike that won the first step. It only
+    /// takes names away.
     #[arg(long)]
     pub look_ahead: bool,
 }

@@ -715,7 +715,10 @@ mod tests {
             let got = basis.fit(&y, trend).expect("fit");
             assert_eq!(got.len(), k);
             for (g, w) in got.iter().zip(want.iter()) {
-                assert!((g - w).abs() < 1e-7 * (1.0 + w.abs()), "{got:?} vs {want:?}");
+                assert!(
+                    (g - w).abs() < 1e-7 * (1.0 + w.abs()),
+                    "{got:?} vs {want:?}"
+                );
             }
         }
     }
