@@ -221,6 +221,21 @@ pub fn select(
     })
 }
 
+/// Where a fitted knob counts as inside its plausible range (unit scale): a value at an
+/// end is the range speaking, not the trials.
+const INSIDE_RANGE: std::ops::RangeInclusive<f64> = 0.01..=0.99;
+
+/// Every free knob of `f` inside its range.
+fn inside_ranges(f: &Fit) -> bool {
+    f.unit.iter().all(|t| INSIDE_RANGE.contains(t))
+}
+
+/// `alt` fits the held-out conditions better than `reference` (a missing held-out χ²
+/// counts as infinite).
+fn held_out_better(alt: &Fit, reference: &Fit) -> bool {
+    alt.held_out.unwrap_or(f64::INFINITY) < reference.held_out.unwrap_or(f64::INFINITY)
+}
+
 /// Neighbouring models confirmed with walks per round (the best by the surrogate).
 const SWAP_WALKS: usize = 6;
 /// Candidates confirmed with walks at a forward step (the best by the surrogate's held-out
@@ -487,7 +502,7 @@ impl Selector<'_, '_> {
                 ));
                 continue;
             }
-            if f.held_out.unwrap_or(f64::INFINITY) >= current.held_out.unwrap_or(f64::INFINITY) {
+            if !held_out_better(f, current) {
                 rows.push(row(*c, "no better on held-out conditions".into(), f, lr, p));
                 continue;
             }
@@ -678,7 +693,7 @@ impl Selector<'_, '_> {
         let k = real.active.len();
         if let Some(t) = real.unit[k - 2..]
             .iter()
-            .find(|t| !(0.01..=0.99).contains(*t))
+            .find(|t| !INSIDE_RANGE.contains(*t))
         {
             return Ok(Err(format!(
                 "a knob fitted at the {} end of its plausible range",
@@ -835,7 +850,7 @@ impl Selector<'_, '_> {
             Ok(within) => within,
             Err(why) => return Ok(Err(why)),
         };
-        if !(0.01..=0.99).contains(&t) {
+        if !INSIDE_RANGE.contains(&t) {
             let why = format!(
                 "fitted at the {} end of its plausible range ({:.3e} {}): the trials want more than the range allows",
                 if t < 0.5 { "lower" } else { "upper" },
@@ -1120,11 +1135,9 @@ impl Selector<'_, '_> {
             .collect();
         walked.sort_by(|a, b| a.1.chi2.total_cmp(&b.1.chi2));
         for (set, real) in &walked {
-            let in_range = real.unit.iter().all(|t| (0.01..=0.99).contains(t));
-            let better = real.chi2 < current.chi2 - margin
-                && real.held_out.unwrap_or(f64::INFINITY)
-                    < current.held_out.unwrap_or(f64::INFINITY)
-                && in_range;
+            let in_range = inside_ranges(real);
+            let better =
+                real.chi2 < current.chi2 - margin && held_out_better(real, current) && in_range;
             if !better {
                 continue;
             }
@@ -1302,6 +1315,8 @@ impl Selector<'_, '_> {
                     .is_some_and(|(_, f)| self.test(f, self.nominal).2 < alpha)
             })
             .collect();
+        // The answer with its held-out χ², made once and only if an alternative needs it.
+        let mut current_held: Option<Fit> = None;
         for (pos, &c) in current.active.iter().enumerate() {
             let label = knobs[c].label();
             let exchanged = |r: usize| -> Vec<usize> {
@@ -1315,15 +1330,11 @@ impl Selector<'_, '_> {
             let same: Vec<Vec<usize>> = outside.iter().map(|&r| exchanged(r)).collect();
             if let Some((set, alt)) = self.best_walked(same, current, LOOK_AHEAD_WALKS)?
                 && alt.chi2 < current.chi2 - margin
-                && alt.unit.iter().all(|t| (0.01..=0.99).contains(t))
+                && inside_ranges(&alt)
             {
-                let own_held = if current.held_out.is_some() {
-                    current.held_out
-                } else {
-                    ctx.with_held_out(current.clone()).held_out
-                };
+                let own = current_held.get_or_insert_with(|| ctx.with_held_out(current.clone()));
                 let alt = ctx.with_held_out(alt);
-                if alt.held_out.unwrap_or(f64::INFINITY) < own_held.unwrap_or(f64::INFINITY) {
+                if held_out_better(&alt, own) {
                     self.unname(steps, &label, knobs[set[pos]].label());
                     self.notes.push(format!(
                         "{} fits these trials better than {} (χ² {:.1} vs {:.1}, \
@@ -1349,14 +1360,16 @@ impl Selector<'_, '_> {
             let Some((set, alt)) = self.best_walked(sets, current, LOOK_AHEAD_WALKS)? else {
                 continue;
             };
-            let in_range = alt.unit.iter().all(|t| (0.01..=0.99).contains(t));
-            if !(alt.chi2 < ref_chi2 - margin && in_range) {
+            if !(alt.chi2 < ref_chi2 - margin && inside_ranges(&alt)) {
                 continue;
             }
-            reference = reference.map(|r| ctx.with_held_out(r));
-            let ref_held = reference.as_ref().map_or(current.held_out, |r| r.held_out);
+            // The reference's held-out χ²: the larger model's, or the answer's own.
+            let held_ref = match reference.take() {
+                Some(r) => reference.insert(ctx.with_held_out(r)),
+                None => current_held.get_or_insert_with(|| ctx.with_held_out(current.clone())),
+            };
             let alt = ctx.with_held_out(alt);
-            if alt.held_out.unwrap_or(f64::INFINITY) >= ref_held.unwrap_or(f64::INFINITY) {
+            if !held_out_better(&alt, held_ref) {
                 continue;
             }
             // The rival stands where `c` stood in the alternative's set.
