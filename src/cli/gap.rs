@@ -334,6 +334,10 @@ pub struct BenchmarkArgs {
     /// --look-ahead`), to measure it. Another benchmark: use its own points file.
     #[arg(long)]
     pub look_ahead: bool,
+    /// Run every case with the diagnosis' experimental joint step (`gap diagnose
+    /// --joint-step`), to measure it. Another benchmark: use its own points file.
+    #[arg(long)]
+    pub joint_step: bool,
     /// Noise levels (relative sd) of the null and single-effect cases.
     #[arg(long, value_delimiter = ',')]
     pub noise: Option<Vec<f64>>,
@@ -359,6 +363,11 @@ pub struct BenchmarkArgs {
     /// ceiling of any rule); compound: a declared parameter error plus each effect.
     #[arg(long, value_delimiter = ',', value_name = "KIND")]
     pub kinds: Vec<String>,
+    /// Run only the cases whose key (the points file's first column) contains one of these
+    /// texts, e.g. `--keys pair/hip_backlash` or one whole key to look at one case again.
+    /// Applied after --kinds; an empty selection is an error.
+    #[arg(long, value_delimiter = ',', value_name = "TEXT")]
+    pub keys: Vec<String>,
     /// Folder for gap-benchmark.md, .json and .svg.
     #[arg(long, value_name = "DIR", default_value = "reports")]
     pub out: PathBuf,
@@ -731,6 +740,7 @@ fn benchmark(a: &BenchmarkArgs) -> anyhow::Result<ExitCode> {
     }
     opts.exchange_rounds = usize::from(a.exchange_rounds);
     opts.look_ahead = a.look_ahead;
+    opts.joint_step = a.joint_step;
     if let Some(n) = &a.noise {
         if let Some(bad) = n.iter().find(|x| !(**x > 0.0 && **x < 1.0)) {
             anyhow::bail!("--noise {bad}: each level must be a fraction in (0, 1)");
@@ -763,6 +773,16 @@ fn benchmark(a: &BenchmarkArgs) -> anyhow::Result<ExitCode> {
     }
     if !a.kinds.is_empty() {
         plan.cases.retain(|c| a.kinds.contains(&c.kind));
+    }
+    if !a.keys.is_empty() {
+        plan.cases
+            .retain(|c| a.keys.iter().any(|k| c.key.contains(k.as_str())));
+        if plan.cases.is_empty() {
+            anyhow::bail!(
+                "--keys {}: no case of this benchmark has such a key (see the points file's first column)",
+                a.keys.join(",")
+            );
+        }
     }
     let rows = if a.merge.is_empty() {
         gap::benchmark::run(&lib, &opts, &plan, a.points.as_deref(), shard, &pb)?
@@ -816,6 +836,9 @@ fn benchmark(a: &BenchmarkArgs) -> anyhow::Result<ExitCode> {
     }
     if a.look_ahead {
         command.push_str(" --look-ahead");
+    }
+    if a.joint_step {
+        command.push_str(" --joint-step");
     }
     if !a.effects.is_empty() {
         command.push_str(&format!(" --effects {}", a.effects.join(",")));

@@ -93,6 +93,10 @@ pub struct BenchmarkOptions {
     /// the diagnosis' default). Part of the signature when on: another benchmark.
     #[serde(default, skip_serializing_if = "is_false")]
     pub look_ahead: bool,
+    /// Every case with the selection's joint step (`SelectOptions::joint_step`; off, the
+    /// diagnosis' default). Part of the signature when on: another benchmark.
+    #[serde(default, skip_serializing_if = "is_false")]
+    pub joint_step: bool,
 }
 
 fn is_false(b: &bool) -> bool {
@@ -110,6 +114,7 @@ impl BenchmarkOptions {
         SelectOptions {
             exchange_rounds: self.exchange_rounds,
             look_ahead: self.look_ahead,
+            joint_step: self.joint_step,
             ..SelectOptions::default()
         }
     }
@@ -176,6 +181,7 @@ impl BenchmarkOptions {
             effects: Vec::new(),
             exchange_rounds: 0,
             look_ahead: false,
+            joint_step: false,
         }
     }
 }

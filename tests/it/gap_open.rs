@@ -819,26 +819,31 @@ fn explore_says_cannot_tell_when_its_sample_is_too_sparse() {
     assert!(stdout(&o).contains("**Cannot tell"), "{}", stdout(&o));
 }
 
-/// The experimental rules (the exchange step's rounds, the look-ahead check) are part of a
-/// benchmark's signature only when the run uses them: the committed points file (written
-/// without them) stays the standard run's, and a run with either cannot be resumed into it.
+/// The experimental rules (the exchange step's rounds, the look-ahead check, the joint step)
+/// are part of a benchmark's signature only when the run uses them: the committed points
+/// file (written without them) stays the standard run's, and a run with any of them cannot
+/// be resumed into it.
 #[test]
 fn a_benchmark_with_an_experimental_rule_is_another_benchmark() {
     let mut opts = BenchmarkOptions::standard("mugatu");
     let plain = serde_json::to_string(&opts).expect("options serialise");
     assert!(!plain.contains("exchange_rounds"), "{plain}");
     assert!(!plain.contains("look_ahead"), "{plain}");
+    assert!(!plain.contains("joint_step"), "{plain}");
     let committed = std::fs::read_to_string(repo().join("reports/gap-benchmark.points.csv"))
         .expect("committed points file");
     let header = committed.lines().next().unwrap_or_default();
     assert!(header.contains("\"one_robot_null_cases\":100"), "{header}");
     assert!(!header.contains("exchange_rounds"), "{header}");
     assert!(!header.contains("look_ahead"), "{header}");
+    assert!(!header.contains("joint_step"), "{header}");
     opts.exchange_rounds = 1;
     opts.look_ahead = true;
+    opts.joint_step = true;
     let with = serde_json::to_string(&opts).expect("options serialise");
     assert!(with.contains("\"exchange_rounds\":1"), "{with}");
     assert!(with.contains("\"look_ahead\":true"), "{with}");
+    assert!(with.contains("\"joint_step\":true"), "{with}");
     // The real binary, resuming a copy of the committed points file with the standard run's
     // options plus one experimental rule: refused at once (before the planning's minutes),
     // naming the file, and the file left as it was.
@@ -847,7 +852,11 @@ fn a_benchmark_with_an_experimental_rule_is_another_benchmark() {
     std::fs::write(&points, &committed).expect("copy");
     let points_arg = points.display().to_string();
     let out_arg = dir.path().join("out").display().to_string();
-    for rule in [&["--look-ahead"][..], &["--exchange-rounds", "1"]] {
+    for rule in [
+        &["--look-ahead"][..],
+        &["--exchange-rounds", "1"],
+        &["--joint-step"],
+    ] {
         let mut args = vec![
             "gap",
             "benchmark",
