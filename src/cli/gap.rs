@@ -162,8 +162,10 @@ pub struct DiagnoseArgs {
     /// Experimental: the joint step. When no single knob passes and the model is still
     /// beyond noise, every pair of knobs is fitted together and the best pair is taken if
     /// it passes a 2-dof test at α over the number of pairs and each of its knobs is
-    /// needed beside the other. Off until the benchmark has measured it: on one of four
-    /// expected-trial pairs tried it led to wrong parameters named.
+    /// needed beside the other. Off: with --exchange-rounds 1 --look-ahead it named both
+    /// causes of 3 more benchmark pairs and nothing on 19 Drake and parameter-error cases,
+    /// but on another noise draw of one pair it named a look-alike (viscous damping for
+    /// Coulomb friction) and a wrong parameter (reports/gap-benchmark.md).
     #[arg(long)]
     pub joint_step: bool,
     /// Experimental: the look-ahead check. Each named knob is weighed at the answer's size

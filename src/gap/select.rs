@@ -46,10 +46,15 @@ pub struct SelectOptions {
     /// benchmark run with it.
     pub exchange_rounds: usize,
     /// Experimental: when no single knob passes and the model is beyond noise, fit pairs of
-    /// knobs together (`Selector::joint`). Off by default: tried on four expected-trial
+    /// knobs together (`Selector::joint`). Off by default. Tried on four expected-trial
     /// cases (2026-11-25) it fired once, after a look-alike first step, and its pair led to
-    /// a chain of wrong parameters that fitted within noise; the two pairs it was built
-    /// for were found without it once the effect test started from the chain's point.
+    /// a chain of wrong parameters. Measured with the exchange step and the look-ahead
+    /// (2026-11-27, reports/gap-benchmark.md, fourth session) on the benchmark cases where
+    /// forward selection stops beyond noise: both causes named in 3 more pairs, nothing
+    /// named on 9 Drake and 10 parameter-error cases; but on another 3 % draw of backlash +
+    /// Coulomb friction its pair was viscous damping + backlash (Coulomb's look-alike,
+    /// named, with a wrong parameter after it): it weighs only the three pairs it walks,
+    /// so a look-alike pair that the surrogate ranks first wins.
     pub joint_step: bool,
     /// The look-ahead check (`Selector::look_ahead`): a named knob that a model of the
     /// answer's size, or one size up, without it fits better than any with it is not
