@@ -1265,9 +1265,10 @@ impl Selector<'_, '_> {
     /// in which `c` is exchanged for a rival `r` — a knob significant alone, so a candidate
     /// look-alike — and one more knob added. Both families are screened on the surrogate and
     /// the best two of each walked, the alternatives only if the surrogate puts them within
-    /// two identification distances of the answer (the exchange step's screen): a walk
-    /// cannot turn a model the surrogate puts far worse into one better by the distance,
-    /// and skipping those walks took the speed case from 195 s to 160 s. An alternative that fits better by more than the
+    /// two identification distances of the answer (the exchange step's screen): one it puts
+    /// further off is taken as not better by the distance once walked, an assumption that
+    /// left the answers of the five pair cases it had changed as they were and took the
+    /// speed case from 195 s to 160 s. An alternative that fits better by more than the
     /// identification distance, on held-out conditions too, and inside its ranges, shows
     /// that `c` is not identified by these trials: no model of that size that keeps it fits
     /// as well as one without it. `c` is then not named (ambiguous with `r`). The check only
