@@ -22,14 +22,10 @@ SURVEY = sys.argv[1] if len(sys.argv) > 1 else "target/release/survey"
 D = Path("tests/golden/drake/gap")
 METRICS = ["velocity_mps", "step_frequency_hz", "roll_pp_deg", "pitch_pp_deg",
            "yaw_pp_deg", "peak_torque_nm", "cot"]
-CASES = [("hip_viscous_damping-0.02", "hip_viscous_damping=0.02"),
-         ("hip_viscous_damping-0.006", "hip_viscous_damping=0.006"),
-         ("hip_coulomb_friction-0.05", "hip_coulomb_friction=0.05"),
-         ("hip_coulomb_friction-0.015", "hip_coulomb_friction=0.015"),
-         ("soft_ground-6e6", "soft_ground=6e6"),
-         ("soft_ground-3e7", "soft_ground=3e7"),
-         ("friction_coefficient-0.4", "friction_coefficient=0.4"),
-         ("friction_coefficient-0.6", "friction_coefficient=0.6")]
+# Every Drake trials file with an effect, named trials-<effect>-<value>.csv as the
+# benchmark reads them: the effect and its value come from the name.
+CASES = [(p.stem[len("trials-"):], "=".join(p.stem[len("trials-"):].rsplit("-", 1)))
+         for p in sorted(D.glob("trials-*.csv")) if p.stem != "trials-none"]
 
 
 def load(path):

@@ -241,6 +241,23 @@ fn held_out_better(alt: &Fit, reference: &Fit) -> bool {
     alt.held_out.unwrap_or(f64::INFINITY) < reference.held_out.unwrap_or(f64::INFINITY)
 }
 
+/// How far above the yardstick (the answer's own surrogate χ²), in identification
+/// distances, a model the surrogate screened may lie and still be walked: the rules that
+/// follow need a walked model within one distance of the answer (a look-alike) or one
+/// better than it, and the surrogate's error near the answer is allowed the rest.
+const SCREEN_DISTANCES: f64 = 2.0;
+
+/// The screened models (best surrogate χ² first) within [`SCREEN_DISTANCES`] distances
+/// `margin` above `yardstick`: those worth a walk.
+fn near(
+    mut screened: Vec<(Vec<usize>, Fit)>,
+    yardstick: f64,
+    margin: f64,
+) -> Vec<(Vec<usize>, Fit)> {
+    screened.retain(|(_, f)| f.chi2 < yardstick + SCREEN_DISTANCES * margin);
+    screened
+}
+
 /// Neighbouring models confirmed with walks per round (the best by the surrogate).
 const SWAP_WALKS: usize = 6;
 /// Candidates confirmed with walks at a forward step (the best by the surrogate's held-out
@@ -1099,9 +1116,7 @@ impl Selector<'_, '_> {
         let n = self.n;
         ctx.progress
             .stage("comparing the model with its neighbours (knobs exchanged)");
-        let phi = dispersion(current.chi2_data, n, current.k());
-        let phi = if phi.is_finite() { phi } else { 1.0 };
-        let margin = separable_margin() * phi;
+        let margin = self.identification_distance(current);
         let mut sorted_current = current.active.clone();
         sorted_current.sort_unstable();
         // The neighbours, each as its knob set.
@@ -1124,15 +1139,8 @@ impl Selector<'_, '_> {
                 }
             }
         }
-        // Screened with the surrogate correction measured at the current model (the
-        // surrogate's bias near the answer), the current model the same way.
-        let own = ctx.screen(
-            &current.active,
-            &[(current.point.clone(), current.correction.clone())],
-            current,
-        );
-        let mut screened = self.screen_sets(neighbours, current);
-        screened.retain(|(_, f)| f.chi2 < own.chi2 + 2.0 * margin);
+        let own = self.own_surrogate_chi2(current);
+        let screened = near(self.screen_sets(neighbours, current), own, margin);
         let mut walked: Vec<(Vec<usize>, Fit)> = self
             .walk_sets(screened, current, SWAP_WALKS, "neighbour")?
             .into_iter()
@@ -1293,9 +1301,7 @@ impl Selector<'_, '_> {
         ctx.progress
             .stage("looking one knob ahead: is each named knob needed?");
         let alpha = self.opts.alpha / knobs.len().max(1) as f64;
-        let phi = dispersion(current.chi2_data, n, current.k());
-        let phi = if phi.is_finite() { phi } else { 1.0 };
-        let margin = separable_margin() * phi;
+        let margin = self.identification_distance(current);
         let outside: Vec<usize> = (0..knobs.len())
             .filter(|k| !current.active.contains(k))
             .collect();
@@ -1307,20 +1313,12 @@ impl Selector<'_, '_> {
                 set
             })
             .collect();
-        // Walks only for models the surrogate puts near enough to matter (as the exchange
-        // step screens its neighbours): a check needs its alternative `margin` better than
-        // the answer (or the reference) once walked, and the surrogate's error near the
-        // answer is allowed two margins more. The answer's own surrogate χ² is the yardstick,
-        // made the way the alternatives are (with the correction measured at the answer).
-        let own = ctx.screen(
-            &current.active,
-            &[(current.point.clone(), current.correction.clone())],
-            current,
-        );
+        // The alternatives are walked only where the surrogate puts them near the answer (or
+        // near the best one-size-up model that keeps it), as the exchange step's neighbours.
+        let own = self.own_surrogate_chi2(current);
         let kept = self.screen_sets(kept, current);
-        let kept_surrogate = kept.first().map_or(own.chi2, |(_, f)| f.chi2.min(own.chi2));
-        let Some((_, reference)) = self.best_of(kept, current, LOOK_AHEAD_WALKS, f64::INFINITY)?
-        else {
+        let kept_surrogate = kept.first().map_or(own, |(_, f)| f.chi2.min(own));
+        let Some((_, reference)) = self.best_of(kept, current, LOOK_AHEAD_WALKS)? else {
             return Ok(());
         };
         // The larger model nests the answer: never worse than it, whatever its search found.
@@ -1350,9 +1348,8 @@ impl Selector<'_, '_> {
             };
             // The answer's own size: `c` exchanged for any knob outside it.
             let same: Vec<Vec<usize>> = outside.iter().map(|&r| exchanged(r)).collect();
-            let same = self.screen_sets(same, current);
-            let ceiling = own.chi2 + 2.0 * margin;
-            if let Some((set, alt)) = self.best_of(same, current, LOOK_AHEAD_WALKS, ceiling)?
+            let same = near(self.screen_sets(same, current), own, margin);
+            if let Some((set, alt)) = self.best_of(same, current, LOOK_AHEAD_WALKS)?
                 && alt.chi2 < current.chi2 - margin
                 && inside_ranges(&alt)
             {
@@ -1381,9 +1378,8 @@ impl Selector<'_, '_> {
                     sets.push(set);
                 }
             }
-            let sets = self.screen_sets(sets, current);
-            let ceiling = kept_surrogate + 2.0 * margin;
-            let Some((set, alt)) = self.best_of(sets, current, LOOK_AHEAD_WALKS, ceiling)? else {
+            let sets = near(self.screen_sets(sets, current), kept_surrogate, margin);
+            let Some((set, alt)) = self.best_of(sets, current, LOOK_AHEAD_WALKS)? else {
                 continue;
             };
             if !(alt.chi2 < ref_chi2 - margin && inside_ranges(&alt)) {
@@ -1457,16 +1453,33 @@ impl Selector<'_, '_> {
         Ok(walked)
     }
 
+    /// The identification distance at `current`: the χ² two models must differ by to be
+    /// told apart, scaled by the over-dispersion left after `current`'s fit.
+    fn identification_distance(&self, current: &Fit) -> f64 {
+        let phi = dispersion(current.chi2_data, self.n, current.k());
+        separable_margin() * if phi.is_finite() { phi } else { 1.0 }
+    }
+
+    /// `current`'s surrogate χ² with the correction measured at it (the surrogate's bias
+    /// near the answer): the yardstick of models screened from it, made the way they are.
+    fn own_surrogate_chi2(&self, current: &Fit) -> f64 {
+        self.ctx
+            .screen(
+                &current.active,
+                &[(current.point.clone(), current.correction.clone())],
+                current,
+            )
+            .chi2
+    }
+
     /// The best of `screened` (from `screen_sets`) by walked χ²: the best `take` on the
-    /// surrogate below `ceiling` (its χ²), confirmed with walks.
+    /// surrogate, confirmed with walks.
     fn best_of(
         &self,
-        mut screened: Vec<(Vec<usize>, Fit)>,
+        screened: Vec<(Vec<usize>, Fit)>,
         from: &Fit,
         take: usize,
-        ceiling: f64,
     ) -> Result<Option<(Vec<usize>, Fit)>, GapError> {
-        screened.retain(|(_, f)| f.chi2 < ceiling);
         Ok(self
             .walk_sets(screened, from, take, "look-ahead model")?
             .into_iter()

@@ -29,6 +29,8 @@ use crate::sim::TrajectorySample;
 /// 12 named 15 + 16 (reports/gap-benchmark.md, 2026-11-27, third session). A log needs
 /// 2H + 8 samples per cycle (Nyquist for the 12th harmonic, with room for the least squares).
 pub const HARMONICS: usize = 12;
+/// Coefficients per signal and cycle: the mean, then a cosine and a sine per harmonic.
+const COEFFICIENTS: usize = 1 + 2 * HARMONICS;
 /// Bins of the phase-averaged cycle drawn in the figure.
 pub const FIGURE_BINS: usize = 48;
 /// Fewest samples per cycle for a cycle to count (the fit has 2H + 2 unknowns).
@@ -443,7 +445,7 @@ struct CycleBasis {
 impl CycleBasis {
     fn new(phases: impl Iterator<Item = f64>) -> CycleBasis {
         let phases: Vec<f64> = phases.collect();
-        let k = 1 + 2 * HARMONICS;
+        let k = COEFFICIENTS;
         let mut a = DMatrix::zeros(phases.len(), k + 1);
         for (r, &phi) in phases.iter().enumerate() {
             let (s1, c1) = (std::f64::consts::TAU * phi).sin_cos();
@@ -466,9 +468,11 @@ impl CycleBasis {
     /// [a₀, a₁, b₁, …, a_H, b_H] of the samples `y` (with the trend column fitted and
     /// dropped when `trend`).
     fn fit(&self, y: &[f64], trend: bool) -> Option<Vec<f64>> {
-        let k = 1 + 2 * HARMONICS;
+        let k = COEFFICIENTS;
         let cols = k + usize::from(trend);
         let a = self.a.columns(0, cols);
+        // The caller passes one value per sample the basis was built from.
+        debug_assert_eq!(y.len(), a.nrows());
         let y = DVector::from_column_slice(y);
         let chol = if trend { &self.trend } else { &self.plain };
         let x = match chol {
@@ -601,7 +605,7 @@ mod tests {
         assert_eq!(sig.cycles, 10, "cycles 2..=11; the cut 12th is dropped");
         let hip = sig.signal(Signal::HipAngle).expect("hip");
         // [a₀, a₁, b₁, a₂, b₂, …]: a_h at 2h − 1, b_h at 2h.
-        let mut want = vec![0.0; 1 + 2 * HARMONICS];
+        let mut want = vec![0.0; COEFFICIENTS];
         (want[0], want[2], want[3], want[6], want[19]) = (2.0, 10.0, 3.0, -1.0, 0.5);
         assert_eq!(hip.coefficients.len(), want.len());
         for (c, w) in hip.coefficients.iter().zip(&want) {
@@ -694,7 +698,7 @@ mod tests {
             .map(|p| (3.0 * p).exp() + (17.0 * p).sin() + if *p > 0.6 { 1.5 } else { 0.0 })
             .collect();
         let basis = CycleBasis::new(phases.iter().copied());
-        let k = 1 + 2 * HARMONICS;
+        let k = COEFFICIENTS;
         for trend in [false, true] {
             let cols = k + usize::from(trend);
             let a = DMatrix::from_fn(phases.len(), cols, |r, c| {
