@@ -177,6 +177,13 @@ pub struct DiagnoseArgs {
     /// takes names away.
     #[arg(long)]
     pub look_ahead: bool,
+    /// Experimental: Levenberg–Marquardt on walks for the two fits the call rule weighs, the
+    /// recalibration of every uncertain parameter and an effect with it (about a dozen
+    /// knobs, which interact where the surrogate cannot see it). Without it those fits can
+    /// stop far above their best, and an effect that beats the recalibration fails the
+    /// test (reports/gap-benchmark.md, fifth session). More walks.
+    #[arg(long)]
+    pub walked_lm: bool,
 }
 
 #[derive(Args, Debug)]
@@ -340,6 +347,10 @@ pub struct BenchmarkArgs {
     /// --joint-step`), to measure it. Another benchmark: use its own points file.
     #[arg(long)]
     pub joint_step: bool,
+    /// Run every case with the diagnosis' experimental Levenberg–Marquardt on walks (`gap
+    /// diagnose --walked-lm`), to measure it. Another benchmark: use its own points file.
+    #[arg(long)]
+    pub walked_lm: bool,
     /// Noise levels (relative sd) of the null and single-effect cases.
     #[arg(long, value_delimiter = ',')]
     pub noise: Option<Vec<f64>>,
@@ -651,6 +662,7 @@ fn diagnose(a: &DiagnoseArgs) -> anyhow::Result<ExitCode> {
             exchange_rounds: usize::from(a.exchange_rounds),
             joint_step: a.joint_step,
             look_ahead: a.look_ahead,
+            walked_lm: a.walked_lm,
             ..gap::select::SelectOptions::default()
         },
         ..DiagnoseOptions::default()
@@ -743,6 +755,7 @@ fn benchmark(a: &BenchmarkArgs) -> anyhow::Result<ExitCode> {
     opts.exchange_rounds = usize::from(a.exchange_rounds);
     opts.look_ahead = a.look_ahead;
     opts.joint_step = a.joint_step;
+    opts.walked_lm = a.walked_lm;
     if let Some(n) = &a.noise {
         if let Some(bad) = n.iter().find(|x| !(**x > 0.0 && **x < 1.0)) {
             anyhow::bail!("--noise {bad}: each level must be a fraction in (0, 1)");
@@ -841,6 +854,9 @@ fn benchmark(a: &BenchmarkArgs) -> anyhow::Result<ExitCode> {
     }
     if a.joint_step {
         command.push_str(" --joint-step");
+    }
+    if a.walked_lm {
+        command.push_str(" --walked-lm");
     }
     if !a.effects.is_empty() {
         command.push_str(&format!(" --effects {}", a.effects.join(",")));

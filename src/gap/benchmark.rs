@@ -97,6 +97,11 @@ pub struct BenchmarkOptions {
     /// diagnosis' default). Part of the signature when on: another benchmark.
     #[serde(default, skip_serializing_if = "is_false")]
     pub joint_step: bool,
+    /// Every case with Levenberg–Marquardt on walks for the recalibration test
+    /// (`SelectOptions::walked_lm`; off, the diagnosis' default). Part of the signature when
+    /// on: another benchmark.
+    #[serde(default, skip_serializing_if = "is_false")]
+    pub walked_lm: bool,
 }
 
 fn is_false(b: &bool) -> bool {
@@ -115,6 +120,7 @@ impl BenchmarkOptions {
             exchange_rounds: self.exchange_rounds,
             look_ahead: self.look_ahead,
             joint_step: self.joint_step,
+            walked_lm: self.walked_lm,
             ..SelectOptions::default()
         }
     }
@@ -182,6 +188,7 @@ impl BenchmarkOptions {
             exchange_rounds: 0,
             look_ahead: false,
             joint_step: false,
+            walked_lm: false,
         }
     }
 }

@@ -519,7 +519,15 @@ pub fn diagnose_conditions(
     };
     let (explanations, calibration) = if opts.explanations {
         (
-            explanations(&ctx, &nominal, &selection, &final_fit, &single, opts.alpha)?,
+            explanations(
+                &ctx,
+                &nominal,
+                &selection,
+                &final_fit,
+                &single,
+                opts.alpha,
+                opts.select.walked_lm,
+            )?,
             match &selection.recalibration {
                 Some(r) => calibrated(&ctx, r),
                 None => Vec::new(),
@@ -687,6 +695,7 @@ fn explanations(
     final_fit: &Fit,
     single: &[SingleFit],
     alpha: f64,
+    walked_lm: bool,
 ) -> Result<Vec<Explanation>, GapError> {
     let mut out = vec![explanation(ctx, "nominal", nominal, nominal, alpha)];
     if let Some(r) = &selection.recalibration {
@@ -719,7 +728,12 @@ fn explanations(
             let mut active = r.active.clone();
             active.push(e);
             let starts = ctx.starts_adding(r, e);
-            let f = ctx.with_held_out(ctx.fit_walked(&active, &starts, None, Some(r))?);
+            let mut f = ctx.fit_walked(&active, &starts, None, Some(r))?;
+            // Fitted as the chain's test fits it, so the table and the call agree.
+            if walked_lm {
+                f = ctx.levenberg_marquardt(f)?;
+            }
+            let f = ctx.with_held_out(f);
             out.push(explanation(
                 ctx,
                 &format!(
