@@ -180,8 +180,9 @@ pub struct DiagnoseArgs {
     /// Experimental: Levenberg–Marquardt on walks for the two fits the call rule weighs, the
     /// recalibration of every uncertain parameter and an effect with it (about a dozen
     /// knobs, which interact where the surrogate cannot see it). Without it those fits can
-    /// stop far above their best, and an effect that beats the recalibration fails the
-    /// test (reports/gap-benchmark.md, fifth session). More walks.
+    /// stop far above their best. Off: on every noisy benchmark pair it named both causes
+    /// of 2 more pairs and of 4 fewer, since the recalibration gains more than an effect
+    /// does (reports/gap-benchmark.md, fifth session); 1.9× the walks.
     #[arg(long)]
     pub walked_lm: bool,
 }

@@ -9,7 +9,7 @@ use super::cache::SimCache;
 use super::error::GapError;
 use super::knob::{Knobs, Point};
 use super::library::EffectLibrary;
-use super::problem::{FELL_Z2, Objective, Observation, chi2_of};
+use super::problem::{Objective, Observation, chi2_of};
 use super::simulate::{Condition, SimMetrics};
 use super::solver::{LmSettings, levenberg_marquardt, minimize, scan, scan_minima};
 use super::surrogate::{Correction, Surrogate};
@@ -398,28 +398,19 @@ impl<'a> FitContext<'a> {
         best.ok_or_else(|| GapError::Invalid("a fit without a start".into()))
     }
 
-    /// The signed residuals of a walked point: each observation's z (a fallen walk charges
-    /// √[`FELL_Z2`]), then each prior-charged free knob's (value − mean)/sd. Their squares
-    /// sum to the fit's χ².
+    /// The signed residuals of a walked point: each observation's z, then each free knob's
+    /// prior z. Their squares sum to the fit's χ² (data + prior).
     fn residuals(&self, active: &[usize], point: &[Option<f64>], sims: &[SimMetrics]) -> Vec<f64> {
         let mut r: Vec<f64> = self
             .obs
             .iter()
-            .map(|o| {
-                let v = sims[o.trial].get(o.metric);
-                if v.is_finite() {
-                    (v - o.value) / o.sd
-                } else {
-                    FELL_Z2.sqrt()
-                }
-            })
+            .map(|o| o.z(sims[o.trial].get(o.metric)))
             .collect();
-        for &k in active {
-            let knob = &self.knobs.list[k];
-            if let (Some((mean, sd)), Some(x)) = (knob.prior, point[k]) {
-                r.push((knob.value(x) - mean) / sd);
-            }
-        }
+        r.extend(
+            active
+                .iter()
+                .filter_map(|&k| point[k].and_then(|x| self.knobs.list[k].prior_z(x))),
+        );
         r
     }
 
@@ -446,7 +437,7 @@ impl<'a> FitContext<'a> {
             step: LM_STEP,
             lambda0: LM_LAMBDA0,
         };
-        let (unit, r) = levenberg_marquardt(
+        let (unit, _) = levenberg_marquardt(
             |u: &[f64]| {
                 let p = point_at(u);
                 let sims = self.walks(&p)?;
@@ -456,13 +447,15 @@ impl<'a> FitContext<'a> {
             r0,
             &settings,
         )?;
-        let chi2: f64 = r.iter().map(|v| v * v).sum();
-        if chi2 >= start.chi2 - 1e-9 {
+        if unit == start.unit {
             return Ok(start);
         }
+        // The solver has walked this point (the walks are cached); its fit is built again
+        // with the prior of every knob, free or not, as the start's χ² has it.
         let point = point_at(&unit);
         let sims = self.walks(&point)?;
-        Ok(self.walked_fit(start.active.clone(), point, unit, sims))
+        let end = self.walked_fit(start.active.clone(), point, unit, sims);
+        Ok(if end.chi2 < start.chi2 { end } else { start })
     }
 
     /// Confirms a surrogate fit with real walks, re-optimising on the surrogate corrected

@@ -95,10 +95,12 @@ impl Knob {
 
     /// The prior's χ² charge of a coordinate (0 without a prior).
     pub fn prior_chi2(&self, x: f64) -> f64 {
-        match self.prior {
-            Some((mean, sd)) => ((self.value(x) - mean) / sd).powi(2),
-            None => 0.0,
-        }
+        self.prior_z(x).map_or(0.0, |z| z.powi(2))
+    }
+
+    /// The prior's signed residual (value − mean) / sd at coordinate `x`, if it has one.
+    pub fn prior_z(&self, x: f64) -> Option<f64> {
+        self.prior.map(|(mean, sd)| (self.value(x) - mean) / sd)
     }
 
     /// Coordinates from the nominal (or off) toward the strongest setting: up from an off

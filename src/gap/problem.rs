@@ -28,13 +28,18 @@ pub struct Observation {
 }
 
 impl Observation {
-    pub fn z2(&self, simulated: f64) -> f64 {
+    /// The signed residual (simulated − measured) / sd; a fallen walk's is √[`FELL_Z2`].
+    pub fn z(&self, simulated: f64) -> f64 {
         if simulated.is_finite() {
-            let z = (simulated - self.value) / self.sd;
-            z * z
+            (simulated - self.value) / self.sd
         } else {
-            FELL_Z2
+            FELL_Z2.sqrt()
         }
+    }
+
+    pub fn z2(&self, simulated: f64) -> f64 {
+        let z = self.z(simulated);
+        z * z
     }
 }
 

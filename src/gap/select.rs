@@ -68,7 +68,9 @@ pub struct SelectOptions {
     /// parameter, and an effect (or pair) with it. Their dozen knobs interact where the
     /// surrogate's one-knob curves cannot see it, so its refinement can stop far above
     /// either model's best, and an effect that does beat the recalibration fails the test.
-    /// Off by default until the whole benchmark has run with it.
+    /// Off: measured on every noisy pair (reports/gap-benchmark.md, fifth session) it named
+    /// both causes of 2 more pairs and of 4 fewer (the recalibration gains more than the
+    /// effect does), at 1.9× the walks.
     pub walked_lm: bool,
 }
 
