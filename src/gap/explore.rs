@@ -195,13 +195,7 @@ pub fn explore(
     let units = latin_hypercube(opts.samples, params.len(), opts.seed);
     let points: Vec<Vec<Option<f64>>> = units
         .iter()
-        .map(|u| {
-            let mut p = knobs.nominal_point();
-            for (s, i) in u.iter().zip(&params) {
-                p[*i] = Some(knobs.list[*i].from_unit(*s));
-            }
-            p
-        })
+        .map(|u| knobs.point_at(&knobs.nominal_point(), &params, u))
         .collect();
     let mut settings = vec![knobs.setting(lib, &knobs.nominal_point())];
     settings.extend(points.iter().map(|p| knobs.setting(lib, p)));

@@ -423,13 +423,7 @@ impl<'a> FitContext<'a> {
         let Some(sims) = start.sims.as_ref() else {
             return Ok(start);
         };
-        let point_at = |unit: &[f64]| -> Point {
-            let mut p = start.point.clone();
-            for (i, &k) in start.active.iter().enumerate() {
-                p[k] = Some(self.knobs.list[k].from_unit(unit[i]));
-            }
-            p
-        };
+        let point_at = |unit: &[f64]| self.knobs.point_at(&start.point, &start.active, unit);
         let r0 = self.residuals(&start.active, &start.point, sims);
         let settings = LmSettings {
             iters: LM_ITERS,

@@ -320,6 +320,16 @@ impl Knobs {
         s
     }
 
+    /// `base` with the knobs `active` set from unit coordinates `unit` (what the solvers
+    /// see) to values.
+    pub fn point_at(&self, base: &[Option<f64>], active: &[usize], unit: &[f64]) -> Point {
+        let mut p = base.to_vec();
+        for (&k, &s) in active.iter().zip(unit) {
+            p[k] = Some(self.list[k].from_unit(s));
+        }
+        p
+    }
+
     /// The prior's χ² charge of a point.
     pub fn prior_chi2(&self, point: &[Option<f64>]) -> f64 {
         self.list

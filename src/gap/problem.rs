@@ -76,11 +76,7 @@ pub struct Objective<'a> {
 impl Objective<'_> {
     /// The full point of unit coordinates `s` of the active knobs.
     pub fn point(&self, s: &[f64]) -> Point {
-        let mut p = self.base.clone();
-        for (i, k) in self.active.iter().enumerate() {
-            p[*k] = Some(self.knobs.list[*k].from_unit(s[i]));
-        }
-        p
+        self.knobs.point_at(self.base, self.active, s)
     }
 
     /// Data χ² (per the skip/only selection) at a full point.

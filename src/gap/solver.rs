@@ -258,13 +258,20 @@ mod tests {
         assert_eq!(calls, 32);
     }
 
-    fn lm(iters: usize) -> LmSettings {
-        LmSettings {
+    /// Levenberg–Marquardt from `start` with `iters` Jacobians (tight difference step).
+    fn solve(
+        mut res: impl FnMut(&[f64]) -> Result<Vec<f64>, ()>,
+        start: &[f64],
+        iters: usize,
+    ) -> (Vec<f64>, Vec<f64>) {
+        let set = LmSettings {
             iters,
             tries: 8,
             step: 1e-7,
             lambda0: 1e-3,
-        }
+        };
+        let r0 = res(start).expect("r0");
+        levenberg_marquardt(res, start, r0, &set).expect("lm")
     }
 
     /// Linear least squares r = A s − b, whose minimum (A's normal equations, solved by
@@ -278,9 +285,7 @@ mod tests {
             let b = [0.25 + 0.1, 1.5 + 0.05, 1.0 - 0.1];
             Ok(vec![s[0] - b[0], 2.0 * s[1] - b[1], s[0] + s[1] - b[2]])
         };
-        let start = [0.9, 0.1];
-        let r0 = res(&start).expect("r0");
-        let (s, r) = levenberg_marquardt(res, &start, r0, &lm(20)).expect("lm");
+        let (s, r) = solve(res, &[0.9, 0.1], 20);
         assert!(
             (s[0] - 0.25).abs() < 1e-6 && (s[1] - 0.75).abs() < 1e-6,
             "{s:?}"
@@ -297,9 +302,7 @@ mod tests {
         let res = |s: &[f64]| -> Result<Vec<f64>, ()> {
             Ok(vec![10.0 * (s[1] - s[0] * s[0]), 0.6 - s[0]])
         };
-        let start = [0.1, 0.9];
-        let r0 = res(&start).expect("r0");
-        let (s, _) = levenberg_marquardt(res, &start, r0, &lm(200)).expect("lm");
+        let (s, _) = solve(res, &[0.1, 0.9], 200);
         assert!(
             (s[0] - 0.6).abs() < 1e-4 && (s[1] - 0.36).abs() < 1e-4,
             "{s:?}"
@@ -315,7 +318,7 @@ mod tests {
             seen_outside |= s.iter().any(|v| !(0.0..=1.0).contains(v));
             Ok(vec![s[0] - 1.5, s[1] - 0.5])
         };
-        let (s, r) = levenberg_marquardt(res, &[0.2, 0.2], vec![-1.3, -0.3], &lm(30)).expect("lm");
+        let (s, r) = solve(res, &[0.2, 0.2], 30);
         assert!(!seen_outside);
         assert_eq!(s[0], 1.0);
         assert!((s[1] - 0.5).abs() < 1e-6, "{s:?}");

@@ -319,7 +319,16 @@ fn two_effects_at_once_are_both_named() {
 #[test]
 fn two_effects_at_once_are_both_named_with_the_parameters_free() {
     let d = coulomb_and_soft_ground(true);
-    for (knob, truth) in [("hip_coulomb_friction", 0.03), ("soft_ground", 4.0e6)] {
+    assert_recovered(
+        &d,
+        &[("hip_coulomb_friction", 0.03), ("soft_ground", 4.0e6)],
+        0.15,
+    );
+}
+
+/// Each named effect `knob` within `tol` (relative) of its true magnitude.
+fn assert_recovered(d: &Diagnosis, truths: &[(&str, f64)], tol: f64) {
+    for &(knob, truth) in truths {
         let named = d
             .answer
             .effects
@@ -327,7 +336,7 @@ fn two_effects_at_once_are_both_named_with_the_parameters_free() {
             .find(|n| n.knob == knob)
             .expect("named");
         assert!(
-            (named.value / truth - 1.0).abs() < 0.15,
+            (named.value / truth - 1.0).abs() < tol,
             "{knob}: {} against the truth {truth}",
             named.value
         );
@@ -388,19 +397,11 @@ fn walked_levenberg_marquardt_lets_a_pair_beat_a_dozen_parameter_recalibration()
         "{}",
         d.answer.statement
     );
-    for (knob, truth) in [("hip_coulomb_friction", 0.019881), ("hip_backlash", 10.521)] {
-        let named = d
-            .answer
-            .effects
-            .iter()
-            .find(|n| n.knob == knob)
-            .expect("named");
-        assert!(
-            (named.value / truth - 1.0).abs() < 0.10,
-            "{knob}: {} against the truth {truth}",
-            named.value
-        );
-    }
+    assert_recovered(
+        &d,
+        &[("hip_coulomb_friction", 0.019881), ("hip_backlash", 10.521)],
+        0.10,
+    );
 }
 
 /// Hip Coulomb friction (0.02 N·m) with the floor's μ 3 % below the design's (0.34 for
