@@ -185,6 +185,19 @@ pub struct DiagnoseArgs {
     /// does (reports/gap-benchmark.md, fifth session); 1.9× the walks.
     #[arg(long)]
     pub walked_lm: bool,
+    /// Experimental: when no knob passes every rule at a step, take an effect that fails
+    /// only the test against the recalibration, and make that test at the end with every
+    /// other effect of the answer in (the effect is dropped if it fails then). Tested
+    /// alone, the first of two causes carries the second one's misfit in the
+    /// over-dispersion that scales its test, so it fails where both together pass.
+    #[arg(long)]
+    pub deferred_recalibration: bool,
+    /// Experimental: compare the look-alikes a step could not tell its knob from again in
+    /// the final model (the knob exchanged for each, walked). At the step a still-missing
+    /// second cause widens the identification distance by its misfit; with every cause of
+    /// the answer in, the trials may tell them apart.
+    #[arg(long)]
+    pub rivals_at_end: bool,
 }
 
 #[derive(Args, Debug)]
@@ -352,6 +365,16 @@ pub struct BenchmarkArgs {
     /// diagnose --walked-lm`), to measure it. Another benchmark: use its own points file.
     #[arg(long)]
     pub walked_lm: bool,
+    /// Run every case with the diagnosis' experimental deferred recalibration test (`gap
+    /// diagnose --deferred-recalibration`), to measure it. Another benchmark: use its own
+    /// points file.
+    #[arg(long)]
+    pub deferred_recalibration: bool,
+    /// Run every case with the diagnosis' experimental end check of look-alikes (`gap
+    /// diagnose --rivals-at-end`), to measure it. Another benchmark: use its own points
+    /// file.
+    #[arg(long)]
+    pub rivals_at_end: bool,
     /// Noise levels (relative sd) of the null and single-effect cases.
     #[arg(long, value_delimiter = ',')]
     pub noise: Option<Vec<f64>>,
@@ -664,6 +687,8 @@ fn diagnose(a: &DiagnoseArgs) -> anyhow::Result<ExitCode> {
             joint_step: a.joint_step,
             look_ahead: a.look_ahead,
             walked_lm: a.walked_lm,
+            deferred_recalibration: a.deferred_recalibration,
+            rivals_at_end: a.rivals_at_end,
             ..gap::select::SelectOptions::default()
         },
         ..DiagnoseOptions::default()
@@ -757,6 +782,8 @@ fn benchmark(a: &BenchmarkArgs) -> anyhow::Result<ExitCode> {
     opts.look_ahead = a.look_ahead;
     opts.joint_step = a.joint_step;
     opts.walked_lm = a.walked_lm;
+    opts.deferred_recalibration = a.deferred_recalibration;
+    opts.rivals_at_end = a.rivals_at_end;
     if let Some(n) = &a.noise {
         if let Some(bad) = n.iter().find(|x| !(**x > 0.0 && **x < 1.0)) {
             anyhow::bail!("--noise {bad}: each level must be a fraction in (0, 1)");
@@ -858,6 +885,12 @@ fn benchmark(a: &BenchmarkArgs) -> anyhow::Result<ExitCode> {
     }
     if a.walked_lm {
         command.push_str(" --walked-lm");
+    }
+    if a.deferred_recalibration {
+        command.push_str(" --deferred-recalibration");
+    }
+    if a.rivals_at_end {
+        command.push_str(" --rivals-at-end");
     }
     if !a.effects.is_empty() {
         command.push_str(&format!(" --effects {}", a.effects.join(",")));

@@ -102,6 +102,16 @@ pub struct BenchmarkOptions {
     /// on: another benchmark.
     #[serde(default, skip_serializing_if = "is_false")]
     pub walked_lm: bool,
+    /// Every case with the recalibration test deferred for an effect that passes every
+    /// other rule when no knob passes them all (`SelectOptions::deferred_recalibration`;
+    /// off, the diagnosis' default). Part of the signature when on: another benchmark.
+    #[serde(default, skip_serializing_if = "is_false")]
+    pub deferred_recalibration: bool,
+    /// Every case with the step's look-alikes compared again in the final model
+    /// (`SelectOptions::rivals_at_end`; off, the diagnosis' default). Part of the signature
+    /// when on: another benchmark.
+    #[serde(default, skip_serializing_if = "is_false")]
+    pub rivals_at_end: bool,
 }
 
 fn is_false(b: &bool) -> bool {
@@ -121,6 +131,8 @@ impl BenchmarkOptions {
             look_ahead: self.look_ahead,
             joint_step: self.joint_step,
             walked_lm: self.walked_lm,
+            deferred_recalibration: self.deferred_recalibration,
+            rivals_at_end: self.rivals_at_end,
             ..SelectOptions::default()
         }
     }
@@ -189,6 +201,8 @@ impl BenchmarkOptions {
             look_ahead: false,
             joint_step: false,
             walked_lm: false,
+            deferred_recalibration: false,
+            rivals_at_end: false,
         }
     }
 }

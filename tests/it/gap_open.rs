@@ -356,51 +356,134 @@ fn assert_recovered(d: &Diagnosis, truths: &[(&str, f64)], tol: f64) {
 /// backlash follows: both causes named, magnitudes within 10 %, nothing else.
 #[test]
 fn walked_levenberg_marquardt_lets_a_pair_beat_a_dozen_parameter_recalibration() {
-    let s = six();
-    let set = TrialSet::read(&repo().join("tests/data/gap/backlash-coulomb-3pct-seed0.csv"))
-        .expect("trials");
-    let conditions = resolve(&set).expect("resolve");
-    let opts = DiagnoseOptions {
-        effects: [
+    let select = SelectOptions {
+        walked_lm: true,
+        ..SelectOptions::default()
+    };
+    let d = diagnose_committed(
+        "backlash-coulomb-3pct-seed0.csv",
+        &[
             "hip_coulomb_friction",
             "hip_viscous_damping",
             "hip_backlash",
-        ]
-        .iter()
-        .map(|e| e.to_string())
-        .collect(),
+        ],
+        &select,
+        &SimCache::default(),
+    );
+    assert_pair_named(
+        &d,
+        [("hip_backlash", 10.521), ("hip_coulomb_friction", 0.019881)],
+    );
+}
+
+/// The full Mugatu's diagnosis (12 uncertain parameters, calibration on) of the committed
+/// trials `tests/data/gap/{file}` with these candidate effects.
+fn diagnose_committed(
+    file: &str,
+    effects: &[&str],
+    select: &SelectOptions,
+    cache: &SimCache,
+) -> Diagnosis {
+    let s = six();
+    let set = TrialSet::read(&repo().join("tests/data/gap").join(file)).expect("trials");
+    let conditions = resolve(&set).expect("resolve");
+    let opts = DiagnoseOptions {
+        effects: effects.iter().map(|e| e.to_string()).collect(),
         calibrate: true,
         explanations: false,
         identifiability: false,
-        select: SelectOptions {
-            walked_lm: true,
-            ..SelectOptions::default()
-        },
+        select: select.clone(),
         ..DiagnoseOptions::default()
     };
-    let d = diagnose_conditions(
-        &set,
-        &conditions,
-        &s.lib,
-        &opts,
-        &SimCache::default(),
-        &Silent,
-    )
-    .expect("diagnosis")
-    .0;
-    let (params, mut effects) = names(&d);
+    diagnose_conditions(&set, &conditions, &s.lib, &opts, cache, &Silent)
+        .expect("diagnosis")
+        .0
+}
+
+/// Exactly the two effects `truths` (sorted by name) named, no parameter, each within 10 %
+/// of its true magnitude.
+fn assert_pair_named(d: &Diagnosis, truths: [(&str, f64); 2]) {
+    let (params, mut effects) = names(d);
     effects.sort();
     assert!(params.is_empty(), "{}", d.answer.statement);
     assert_eq!(
         effects,
-        vec!["hip_backlash", "hip_coulomb_friction"],
+        truths.map(|(k, _)| k.to_string()).to_vec(),
         "{}",
         d.answer.statement
     );
-    assert_recovered(
+    assert_recovered(d, &truths, 0.10);
+}
+
+/// The benchmark's noisy pair "motor torque–speed line + soft ground" at 2× their
+/// identification thresholds (3 % noise, the benchmark's own draw:
+/// `tests/data/gap/motor-soft-3pct-bench.csv`, command in its `source` column). Soft ground
+/// explains most of the gap alone (LR 2582 against the nominal) but, tested alone against
+/// the recalibration of Mugatu's 12 uncertain parameters, its LR of 56 is scaled by an
+/// over-dispersion that still holds the missing motor line's misfit: p = 1.4e-3, not
+/// called, and the answer was "partly explained, nothing named" (measured 2026-11-27 with
+/// every candidate). With the test deferred to the end (`deferred_recalibration`), soft
+/// ground is taken, the motor line follows and passes, and soft ground then beats the
+/// recalibration with the motor line in (p = 8e-34): both named within 10 %. The default
+/// answer on the same trials is checked too: without the option the pair is not named.
+#[test]
+fn a_deferred_recalibration_test_names_both_causes_of_a_pair() {
+    let cache = SimCache::default();
+    let effects = [
+        "soft_ground",
+        "motor_torque_speed",
+        "hip_coulomb_friction",
+        "hip_viscous_damping",
+    ];
+    let file = "motor-soft-3pct-bench.csv";
+    let plain = diagnose_committed(file, &effects, &SelectOptions::default(), &cache);
+    assert!(
+        names(&plain).1.len() < 2,
+        "the default names both: {}",
+        plain.answer.statement
+    );
+    let select = SelectOptions {
+        deferred_recalibration: true,
+        ..SelectOptions::default()
+    };
+    let d = diagnose_committed(file, &effects, &select, &cache);
+    assert_pair_named(
         &d,
-        &[("hip_coulomb_friction", 0.019881), ("hip_backlash", 10.521)],
-        0.10,
+        [("motor_torque_speed", 3.6834), ("soft_ground", 3.1121e6)],
+    );
+}
+
+/// The benchmark's noisy pair "backlash + hip viscous damping" (2× thresholds, 3 % noise,
+/// its own draw: `tests/data/gap/backlash-damping-3pct-bench.csv`). Damping is taken first,
+/// with the missing backlash's misfit in its over-dispersion (φ 18.9): the identification
+/// distance at that step is 124 in χ², so hip Coulomb friction is "not separable" from it
+/// and damping is not named (only backlash was, measured 2026-11-27). In the final model
+/// (damping + backlash, φ 1.0) Coulomb friction exchanged for damping fits worse by χ² 125
+/// against a distance of 6.6: `rivals_at_end` tells them apart and both causes are named,
+/// within 10 %. Without it the default leaves damping unnamed on the same trials.
+#[test]
+fn look_alikes_compared_again_in_the_final_model_name_both_causes_of_a_pair() {
+    let cache = SimCache::default();
+    let effects = [
+        "hip_backlash",
+        "hip_viscous_damping",
+        "hip_coulomb_friction",
+    ];
+    let file = "backlash-damping-3pct-bench.csv";
+    let plain = diagnose_committed(file, &effects, &SelectOptions::default(), &cache);
+    assert!(
+        !names(&plain).1.contains(&"hip_viscous_damping".to_string()),
+        "the default names damping: {}",
+        plain.answer.statement
+    );
+    let select = SelectOptions {
+        rivals_at_end: true,
+        ..SelectOptions::default()
+    };
+    let d = diagnose_committed(file, &effects, &select, &cache);
+    assert_pair_named(
+        &d,
+        [("hip_backlash", 10.521), ("hip_viscous_damping", 0.0067636)],
     );
 }
 
@@ -889,7 +972,8 @@ fn explore_says_cannot_tell_when_its_sample_is_too_sparse() {
     assert!(stdout(&o).contains("**Cannot tell"), "{}", stdout(&o));
 }
 
-/// The experimental rules (the exchange step's rounds, the look-ahead check, the joint step)
+/// The experimental rules (the exchange step's rounds, the look-ahead check, the joint step,
+/// Levenberg–Marquardt on walks, the deferred recalibration test, look-alikes at the end)
 /// are part of a benchmark's signature only when the run uses them: the committed points
 /// file (written without them) stays the standard run's, and a run with any of them cannot
 /// be resumed into it.
@@ -901,6 +985,8 @@ fn a_benchmark_with_an_experimental_rule_is_another_benchmark() {
     assert!(!plain.contains("look_ahead"), "{plain}");
     assert!(!plain.contains("joint_step"), "{plain}");
     assert!(!plain.contains("walked_lm"), "{plain}");
+    assert!(!plain.contains("deferred_recalibration"), "{plain}");
+    assert!(!plain.contains("rivals_at_end"), "{plain}");
     let committed = std::fs::read_to_string(repo().join("reports/gap-benchmark.points.csv"))
         .expect("committed points file");
     let header = committed.lines().next().unwrap_or_default();
@@ -909,15 +995,21 @@ fn a_benchmark_with_an_experimental_rule_is_another_benchmark() {
     assert!(!header.contains("look_ahead"), "{header}");
     assert!(!header.contains("joint_step"), "{header}");
     assert!(!header.contains("walked_lm"), "{header}");
+    assert!(!header.contains("deferred_recalibration"), "{header}");
+    assert!(!header.contains("rivals_at_end"), "{header}");
     opts.exchange_rounds = 1;
     opts.look_ahead = true;
     opts.joint_step = true;
     opts.walked_lm = true;
+    opts.deferred_recalibration = true;
+    opts.rivals_at_end = true;
     let with = serde_json::to_string(&opts).expect("options serialise");
     assert!(with.contains("\"exchange_rounds\":1"), "{with}");
     assert!(with.contains("\"look_ahead\":true"), "{with}");
     assert!(with.contains("\"joint_step\":true"), "{with}");
     assert!(with.contains("\"walked_lm\":true"), "{with}");
+    assert!(with.contains("\"deferred_recalibration\":true"), "{with}");
+    assert!(with.contains("\"rivals_at_end\":true"), "{with}");
     // The real binary, resuming a copy of the committed points file with the standard run's
     // options plus one experimental rule: refused at once (before the planning's minutes),
     // naming the file, and the file left as it was.
@@ -931,6 +1023,8 @@ fn a_benchmark_with_an_experimental_rule_is_another_benchmark() {
         &["--exchange-rounds", "1"],
         &["--joint-step"],
         &["--walked-lm"],
+        &["--deferred-recalibration"],
+        &["--rivals-at-end"],
     ] {
         let mut args = vec![
             "gap",
