@@ -187,7 +187,8 @@ pub struct DiagnoseArgs {
     pub walked_lm: bool,
     /// Experimental: when no knob passes every rule at a step, take an effect that fails
     /// only the test against the recalibration, and make that test at the end with every
-    /// other effect of the answer in (the effect is dropped if it fails then). Tested
+    /// other effect of the answer in (if it fails then, the search is made again without
+    /// deferring it: the answer the default would give). Tested
     /// alone, the first of two causes carries the second one's misfit in the
     /// over-dispersion that scales its test, so it fails where both together pass.
     #[arg(long)]
