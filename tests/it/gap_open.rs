@@ -400,6 +400,14 @@ fn diagnose_committed(
         .0
 }
 
+/// The diagnoses of committed trials by default and with `select` (one walk cache: the
+/// second reuses the first's walks).
+fn default_and_with(file: &str, effects: &[&str], select: SelectOptions) -> (Diagnosis, Diagnosis) {
+    let cache = SimCache::default();
+    let plain = diagnose_committed(file, effects, &SelectOptions::default(), &cache);
+    (plain, diagnose_committed(file, effects, &select, &cache))
+}
+
 /// Exactly the two effects `truths` (sorted by name) named, no parameter, each within 10 %
 /// of its true magnitude.
 fn assert_pair_named(d: &Diagnosis, truths: [(&str, f64); 2]) {
@@ -428,25 +436,24 @@ fn assert_pair_named(d: &Diagnosis, truths: [(&str, f64); 2]) {
 /// answer on the same trials is checked too: without the option the pair is not named.
 #[test]
 fn a_deferred_recalibration_test_names_both_causes_of_a_pair() {
-    let cache = SimCache::default();
-    let effects = [
-        "soft_ground",
-        "motor_torque_speed",
-        "hip_coulomb_friction",
-        "hip_viscous_damping",
-    ];
-    let file = "motor-soft-3pct-bench.csv";
-    let plain = diagnose_committed(file, &effects, &SelectOptions::default(), &cache);
+    let (plain, d) = default_and_with(
+        "motor-soft-3pct-bench.csv",
+        &[
+            "soft_ground",
+            "motor_torque_speed",
+            "hip_coulomb_friction",
+            "hip_viscous_damping",
+        ],
+        SelectOptions {
+            deferred_recalibration: true,
+            ..SelectOptions::default()
+        },
+    );
     assert!(
         names(&plain).1.len() < 2,
         "the default names both: {}",
         plain.answer.statement
     );
-    let select = SelectOptions {
-        deferred_recalibration: true,
-        ..SelectOptions::default()
-    };
-    let d = diagnose_committed(file, &effects, &select, &cache);
     assert_pair_named(
         &d,
         [("motor_torque_speed", 3.6834), ("soft_ground", 3.1121e6)],
@@ -463,24 +470,23 @@ fn a_deferred_recalibration_test_names_both_causes_of_a_pair() {
 /// within 10 %. Without it the default leaves damping unnamed on the same trials.
 #[test]
 fn look_alikes_compared_again_in_the_final_model_name_both_causes_of_a_pair() {
-    let cache = SimCache::default();
-    let effects = [
-        "hip_backlash",
-        "hip_viscous_damping",
-        "hip_coulomb_friction",
-    ];
-    let file = "backlash-damping-3pct-bench.csv";
-    let plain = diagnose_committed(file, &effects, &SelectOptions::default(), &cache);
+    let (plain, d) = default_and_with(
+        "backlash-damping-3pct-bench.csv",
+        &[
+            "hip_backlash",
+            "hip_viscous_damping",
+            "hip_coulomb_friction",
+        ],
+        SelectOptions {
+            rivals_at_end: true,
+            ..SelectOptions::default()
+        },
+    );
     assert!(
         !names(&plain).1.contains(&"hip_viscous_damping".to_string()),
         "the default names damping: {}",
         plain.answer.statement
     );
-    let select = SelectOptions {
-        rivals_at_end: true,
-        ..SelectOptions::default()
-    };
-    let d = diagnose_committed(file, &effects, &select, &cache);
     assert_pair_named(
         &d,
         [("hip_backlash", 10.521), ("hip_viscous_damping", 0.0067636)],
