@@ -199,6 +199,13 @@ pub struct DiagnoseArgs {
     /// the answer in, the trials may tell them apart.
     #[arg(long)]
     pub rivals_at_end: bool,
+    /// Experimental: find every named knob's look-alikes again in the final model, among
+    /// all knobs outside it (the knob exchanged for each, screened, the nearest walked):
+    /// one within the identification distance makes the knob ambiguous, as at a step. A
+    /// look-alike a step could not see (its second cause still missing) then shows.
+    /// Supersedes --rivals-at-end: flags are cleared only when no named knob has one.
+    #[arg(long)]
+    pub look_alikes_at_end: bool,
 }
 
 #[derive(Args, Debug)]
@@ -376,6 +383,11 @@ pub struct BenchmarkArgs {
     /// file.
     #[arg(long)]
     pub rivals_at_end: bool,
+    /// Run every case with the diagnosis' experimental end search for look-alikes (`gap
+    /// diagnose --look-alikes-at-end`), to measure it. Another benchmark: use its own
+    /// points file.
+    #[arg(long)]
+    pub look_alikes_at_end: bool,
     /// Noise levels (relative sd) of the null and single-effect cases.
     #[arg(long, value_delimiter = ',')]
     pub noise: Option<Vec<f64>>,
@@ -690,6 +702,7 @@ fn diagnose(a: &DiagnoseArgs) -> anyhow::Result<ExitCode> {
             walked_lm: a.walked_lm,
             deferred_recalibration: a.deferred_recalibration,
             rivals_at_end: a.rivals_at_end,
+            look_alikes_at_end: a.look_alikes_at_end,
             ..gap::select::SelectOptions::default()
         },
         ..DiagnoseOptions::default()
@@ -785,6 +798,7 @@ fn benchmark(a: &BenchmarkArgs) -> anyhow::Result<ExitCode> {
     opts.walked_lm = a.walked_lm;
     opts.deferred_recalibration = a.deferred_recalibration;
     opts.rivals_at_end = a.rivals_at_end;
+    opts.look_alikes_at_end = a.look_alikes_at_end;
     if let Some(n) = &a.noise {
         if let Some(bad) = n.iter().find(|x| !(**x > 0.0 && **x < 1.0)) {
             anyhow::bail!("--noise {bad}: each level must be a fraction in (0, 1)");
@@ -892,6 +906,9 @@ fn benchmark(a: &BenchmarkArgs) -> anyhow::Result<ExitCode> {
     }
     if a.rivals_at_end {
         command.push_str(" --rivals-at-end");
+    }
+    if a.look_alikes_at_end {
+        command.push_str(" --look-alikes-at-end");
     }
     if !a.effects.is_empty() {
         command.push_str(&format!(" --effects {}", a.effects.join(",")));

@@ -112,6 +112,11 @@ pub struct BenchmarkOptions {
     /// when on: another benchmark.
     #[serde(default, skip_serializing_if = "is_false")]
     pub rivals_at_end: bool,
+    /// Every case with every named knob's look-alikes found again in the final model
+    /// (`SelectOptions::look_alikes_at_end`; off, the diagnosis' default). Part of the
+    /// signature when on: another benchmark.
+    #[serde(default, skip_serializing_if = "is_false")]
+    pub look_alikes_at_end: bool,
 }
 
 fn is_false(b: &bool) -> bool {
@@ -133,6 +138,7 @@ impl BenchmarkOptions {
             walked_lm: self.walked_lm,
             deferred_recalibration: self.deferred_recalibration,
             rivals_at_end: self.rivals_at_end,
+            look_alikes_at_end: self.look_alikes_at_end,
             ..SelectOptions::default()
         }
     }
@@ -203,6 +209,7 @@ impl BenchmarkOptions {
             walked_lm: false,
             deferred_recalibration: false,
             rivals_at_end: false,
+            look_alikes_at_end: false,
         }
     }
 }

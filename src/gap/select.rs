@@ -95,6 +95,16 @@ pub struct SelectOptions {
     /// so most near candidates are "not separable"; with both causes in, φ ≈ 1. Measured
     /// with `deferred_recalibration` (above); off until the whole benchmark has run with it.
     pub rivals_at_end: bool,
+    /// Experimental: every named knob's look-alikes found again in the final model, among
+    /// all knobs outside it (`Selector::look_alikes_at_end`), by the step's own rule: the
+    /// knob exchanged for another fits within the identification distance, the other is
+    /// significant there and is not a complement. It supersedes `rivals_at_end` (which
+    /// weighs only the rivals a step flagged): a look-alike the step did not flag — hip
+    /// viscous damping taken alone for Coulomb friction while a motor line was still
+    /// missing, with Coulomb friction worse by more than the distance at that step but
+    /// alike once the motor line is in — makes the knob ambiguous; flags are cleared only
+    /// when no named knob has a look-alike in the final model.
+    pub look_alikes_at_end: bool,
 }
 
 impl Default for SelectOptions {
@@ -110,6 +120,7 @@ impl Default for SelectOptions {
             walked_lm: false,
             deferred_recalibration: false,
             rivals_at_end: false,
+            look_alikes_at_end: false,
         }
     }
 }
@@ -268,7 +279,9 @@ pub fn select(
         }
         break (current, steps);
     };
-    if opts.rivals_at_end {
+    if opts.look_alikes_at_end {
+        sel.look_alikes_at_end(&current, &mut steps)?;
+    } else if opts.rivals_at_end {
         sel.rivals_at_end(&current, &mut steps)?;
     }
     if opts.look_ahead {
@@ -333,6 +346,10 @@ const SWAP_WALKS: usize = 6;
 const STEP_WALKS: usize = 3;
 /// Models of each family confirmed with walks by the look-ahead check.
 const LOOK_AHEAD_WALKS: usize = 2;
+/// Exchanges of a named knob the end check of look-alikes confirms with walks (the best by
+/// the surrogate within its screen), besides the rivals its step flagged: as many as a
+/// forward step walks.
+const LOOK_ALIKE_WALKS: usize = STEP_WALKS;
 /// Pairs of knobs confirmed with walks at a joint step (the best by the surrogate).
 const JOINT_WALKS: usize = 3;
 
@@ -691,6 +708,128 @@ impl Selector<'_, '_> {
         for (i, why) in resolved {
             steps[i].not_separable_from.clear();
             self.notes.push(why);
+        }
+        Ok(())
+    }
+
+    /// Every named knob's look-alikes found again in the final model
+    /// (`SelectOptions::look_alikes_at_end`). For each knob `c` of the answer: the answer
+    /// with `c` exchanged for each knob outside it is screened on the surrogate, and the
+    /// best [`LOOK_ALIKE_WALKS`] within [`SCREEN_DISTANCES`] identification distances, with
+    /// every rival `c`'s step flagged, are walked. An exchange is a look-alike by the
+    /// step's rule (`rivals_at_step`): it fits within the identification distance at the
+    /// answer's over-dispersion (or better), its knob is significant against the answer
+    /// without `c`, and it is not a complement (not significant on top of the answer).
+    ///
+    /// Look-alikes found are added to the step's (a step with any names none). Flags are
+    /// cleared only when no named knob has one: each comparison holds the rest of the
+    /// answer fixed, and a rest holding a look-alike is no ground to tell the others apart.
+    fn look_alikes_at_end(&mut self, current: &Fit, steps: &mut [Step]) -> Result<(), GapError> {
+        let ctx = self.ctx;
+        let knobs = &ctx.knobs.list;
+        let n = self.n;
+        if current.active.is_empty() || n <= current.k() + 1 {
+            return Ok(());
+        }
+        let margin = self.identification_distance(current);
+        let outside: Vec<usize> = (0..knobs.len())
+            .filter(|k| !current.active.contains(k))
+            .collect();
+        // α over the knobs a step from the answer without `c` would weigh, as at a step.
+        let alpha = self.opts.alpha / (outside.len() + 1) as f64;
+        let own = self.own_surrogate_chi2(current);
+        let mut found: Vec<(usize, Vec<String>)> = Vec::new();
+        for (i, step) in steps.iter().enumerate() {
+            let Some(c) = ctx.knobs.index_of(&step.knob) else {
+                continue;
+            };
+            if !current.active.contains(&c) {
+                continue;
+            }
+            ctx.progress
+                .stage(&format!("look-alikes of {} in the final model", step.knob));
+            let exchanged = |r: usize| -> Vec<usize> {
+                current
+                    .active
+                    .iter()
+                    .map(|&k| if k == c { r } else { k })
+                    .collect()
+            };
+            // The answer without `c`, walked (the nominal when `c` is its only knob): what
+            // a look-alike must be significant against.
+            let without = if current.active.len() == 1 {
+                self.nominal.clone()
+            } else {
+                let set: Vec<usize> = current.active.iter().copied().filter(|k| *k != c).collect();
+                let mut start = current.point.clone();
+                start[c] = None;
+                ctx.fit_walked(&set, &[(start, current.correction.clone())], None, None)?
+            };
+            let flagged: Vec<usize> = step
+                .not_separable_from
+                .iter()
+                .filter_map(|l| ctx.knobs.index_of(l))
+                .filter(|r| !current.active.contains(r))
+                .collect();
+            let same: Vec<Vec<usize>> = outside
+                .iter()
+                .filter(|r| !flagged.contains(r))
+                .map(|&r| exchanged(r))
+                .collect();
+            let mut sets: Vec<(Vec<usize>, Fit)> =
+                near(self.screen_sets(same, current), own, margin)
+                    .into_iter()
+                    .take(LOOK_ALIKE_WALKS)
+                    .collect();
+            sets.extend(self.screen_sets(flagged.iter().map(|&r| exchanged(r)).collect(), current));
+            let mut alike: Vec<String> = Vec::new();
+            for (set, alt) in self.walk_sets(sets, current, usize::MAX, "look-alike model")? {
+                let Some(&r) = set.iter().find(|k| !current.active.contains(k)) else {
+                    continue;
+                };
+                if alt.chi2 - current.chi2 < margin && self.test(&alt, &without).2 < alpha {
+                    alike.push(knobs[r].label());
+                }
+            }
+            let alike = self.complements_removed(current, alike, alpha)?;
+            found.push((i, alike));
+        }
+        if found.iter().all(|(_, a)| a.is_empty()) {
+            let cleared: Vec<String> = steps
+                .iter_mut()
+                .filter(|s| !s.not_separable_from.is_empty())
+                .map(|s| {
+                    let why = format!("{} (was: {})", s.knob, s.not_separable_from.join(", "));
+                    s.not_separable_from.clear();
+                    why
+                })
+                .collect();
+            if !cleared.is_empty() {
+                self.notes.push(format!(
+                    "look-alikes found again in the final model: none within the \
+                     identification distance ({margin:.1}) of any named knob, so these are \
+                     told apart: {}",
+                    cleared.join("; ")
+                ));
+            }
+            return Ok(());
+        }
+        for (i, alike) in found {
+            let step = &mut steps[i];
+            let new: Vec<String> = alike
+                .into_iter()
+                .filter(|a| !step.not_separable_from.contains(a))
+                .collect();
+            if new.is_empty() {
+                continue;
+            }
+            self.notes.push(format!(
+                "{} is not told apart from {} in the final model (each exchanged in fits \
+                 within the identification distance {margin:.1}): not named",
+                step.knob,
+                new.join(", ")
+            ));
+            step.not_separable_from.extend(new);
         }
         Ok(())
     }
