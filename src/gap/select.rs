@@ -311,6 +311,11 @@ fn not_beating(lr: f64, p: f64) -> String {
 /// end is the range speaking, not the trials.
 const INSIDE_RANGE: std::ops::RangeInclusive<f64> = 0.01..=0.99;
 
+/// The knob set `active` with knob `c` exchanged for `r`, in `c`'s place.
+fn exchanged(active: &[usize], c: usize, r: usize) -> Vec<usize> {
+    active.iter().map(|&k| if k == c { r } else { k }).collect()
+}
+
 /// Every free knob of `f` inside its range.
 fn inside_ranges(f: &Fit) -> bool {
     f.unit.iter().all(|t| INSIDE_RANGE.contains(t))
@@ -748,13 +753,7 @@ impl Selector<'_, '_> {
             }
             ctx.progress
                 .stage(&format!("look-alikes of {} in the final model", step.knob));
-            let exchanged = |r: usize| -> Vec<usize> {
-                current
-                    .active
-                    .iter()
-                    .map(|&k| if k == c { r } else { k })
-                    .collect()
-            };
+            let exchanged = |r: usize| exchanged(&current.active, c, r);
             // The answer without `c`, walked (the nominal when `c` is its only knob): what
             // a look-alike must be significant against.
             let without = if current.active.len() == 1 {
@@ -1802,13 +1801,7 @@ impl Selector<'_, '_> {
         let mut current_held: Option<Fit> = None;
         for (pos, &c) in current.active.iter().enumerate() {
             let label = knobs[c].label();
-            let exchanged = |r: usize| -> Vec<usize> {
-                current
-                    .active
-                    .iter()
-                    .map(|&k| if k == c { r } else { k })
-                    .collect()
-            };
+            let exchanged = |r: usize| exchanged(&current.active, c, r);
             // The answer's own size: `c` exchanged for any knob outside it.
             let same: Vec<Vec<usize>> = outside.iter().map(|&r| exchanged(r)).collect();
             let same = near(self.screen_sets(same, current), own, margin);

@@ -423,6 +423,20 @@ fn default_and_each(
     (plain, with)
 }
 
+/// Viscous damping and hip Coulomb friction in one group of look-alikes (`context` leads
+/// the failure message).
+fn assert_damping_and_coulomb_ambiguous(d: &Diagnosis, context: &str) {
+    assert!(
+        d.answer
+            .ambiguous
+            .iter()
+            .any(|g| g.contains(&"hip_viscous_damping".to_string())
+                && g.contains(&"hip_coulomb_friction".to_string())),
+        "{context}{}",
+        d.answer.statement
+    );
+}
+
 /// Exactly the two effects `truths` (sorted by name) named, no parameter, each within 10 %
 /// of its true magnitude.
 fn assert_pair_named(d: &Diagnosis, truths: [(&str, f64); 2]) {
@@ -556,15 +570,7 @@ fn a_look_alike_found_again_in_the_final_model_unnames_a_stand_in() {
         d.answer.statement
     );
     assert_recovered(&d, &[("motor_torque_speed", 3.6834)], 0.10);
-    assert!(
-        d.answer
-            .ambiguous
-            .iter()
-            .any(|g| g.contains(&"hip_viscous_damping".to_string())
-                && g.contains(&"hip_coulomb_friction".to_string())),
-        "{}",
-        d.answer.statement
-    );
+    assert_damping_and_coulomb_ambiguous(&d, "");
 }
 
 /// Hip Coulomb friction (0.02 N·m) with the floor's μ 3 % below the design's (0.34 for
@@ -617,15 +623,7 @@ fn the_look_ahead_check_unnames_a_look_alike_that_won_the_first_step() {
             "seed {seed:?}: a knob outside the truth named: {}",
             d.answer.statement
         );
-        assert!(
-            d.answer
-                .ambiguous
-                .iter()
-                .any(|g| g.contains(&"hip_viscous_damping".to_string())
-                    && g.contains(&"hip_coulomb_friction".to_string())),
-            "seed {seed:?}: {}",
-            d.answer.statement
-        );
+        assert_damping_and_coulomb_ambiguous(&d, &format!("seed {seed:?}: "));
     }
     for (effect, si) in [
         ("hip_viscous_damping", 0.007),
