@@ -168,6 +168,20 @@ pub struct LmSettings {
     pub lambda0: f64,
 }
 
+/// One damped Gauss–Newton step for residuals `r` with Jacobian `jac`: the δ that solves
+/// (JᵀJ + λ·diag(JᵀJ))·δ = −Jᵀr (Marquardt's scaling), or `None` where that matrix is
+/// not positive definite.
+pub fn gauss_newton_step(jac: &nalgebra::DMatrix<f64>, r: &[f64], lambda: f64) -> Option<Vec<f64>> {
+    let jtj = jac.transpose() * jac;
+    let g = jac.transpose() * nalgebra::DVector::from_column_slice(r);
+    let mut a = jtj.clone();
+    for i in 0..jac.ncols() {
+        a[(i, i)] += lambda * jtj[(i, i)].max(1e-12);
+    }
+    let delta = a.cholesky()?.solve(&(-g));
+    Some(delta.iter().copied().collect())
+}
+
 /// Levenberg–Marquardt on residuals r(s) over the unit box (cost Σr²), from `start` whose
 /// residuals are `r0`: a forward-difference Jacobian, the damped normal equations
 /// (JᵀJ + λ·diag JᵀJ) δ = −Jᵀr solved by Cholesky, the step clipped to the box and taken
@@ -204,19 +218,12 @@ pub fn levenberg_marquardt<E>(
                 jac[(row, i)] = (a - b) / h;
             }
         }
-        let jtj = jac.transpose() * &jac;
-        let g = jac.transpose() * nalgebra::DVector::from_column_slice(&r);
         let mut accepted = false;
         for _ in 0..set.tries {
-            let mut a = jtj.clone();
-            for i in 0..k {
-                a[(i, i)] += lambda * jtj[(i, i)].max(1e-12);
-            }
-            let Some(chol) = a.cholesky() else {
+            let Some(delta) = gauss_newton_step(&jac, &r, lambda) else {
                 lambda *= 4.0;
                 continue;
             };
-            let delta = chol.solve(&(-&g));
             let u: Vec<f64> = s
                 .iter()
                 .zip(delta.iter())
@@ -277,6 +284,22 @@ mod tests {
     /// Linear least squares r = A s − b, whose minimum (A's normal equations, solved by
     /// hand: s = (0.25, 0.75)) lies inside the box: forward differences are exact on a
     /// linear map, so a few damped Gauss–Newton steps land on it.
+    /// J = [[1, 0], [0, 2], [1, 1]], r = (1, 2, 3): JᵀJ = [[2, 1], [1, 5]], Jᵀr = (4, 7), so
+    /// the undamped step is −(JᵀJ)⁻¹Jᵀr = −(13, 10)/9 (by hand); damped by λ = 1 the
+    /// matrix is [[4, 1], [1, 10]] and the step −(33, 24)/39. A zero Jacobian has none.
+    #[test]
+    fn gauss_newton_step_solves_the_normal_equations_by_hand() {
+        let jac = nalgebra::DMatrix::from_row_slice(3, 2, &[1.0, 0.0, 0.0, 2.0, 1.0, 1.0]);
+        let r = [1.0, 2.0, 3.0];
+        let close = |a: &[f64], b: &[f64]| a.iter().zip(b).all(|(x, y)| (x - y).abs() < 1e-12);
+        let d0 = gauss_newton_step(&jac, &r, 0.0).expect("positive definite");
+        assert!(close(&d0, &[-13.0 / 9.0, -10.0 / 9.0]), "{d0:?}");
+        let d1 = gauss_newton_step(&jac, &r, 1.0).expect("positive definite");
+        assert!(close(&d1, &[-33.0 / 39.0, -24.0 / 39.0]), "{d1:?}");
+        let zero = nalgebra::DMatrix::<f64>::zeros(3, 2);
+        assert!(gauss_newton_step(&zero, &r, 0.0).is_none());
+    }
+
     #[test]
     fn levenberg_marquardt_solves_a_linear_least_squares_problem() {
         // A = [[1, 0], [0, 2], [1, 1]], b = A·(0.25, 0.75) + a residual orthogonal to A's
