@@ -281,9 +281,6 @@ mod tests {
         levenberg_marquardt(res, start, r0, &set).expect("lm")
     }
 
-    /// Linear least squares r = A s − b, whose minimum (A's normal equations, solved by
-    /// hand: s = (0.25, 0.75)) lies inside the box: forward differences are exact on a
-    /// linear map, so a few damped Gauss–Newton steps land on it.
     /// J = [[1, 0], [0, 2], [1, 1]], r = (1, 2, 3): JᵀJ = [[2, 1], [1, 5]], Jᵀr = (4, 7), so
     /// the undamped step is −(JᵀJ)⁻¹Jᵀr = −(13, 10)/9 (by hand); damped by λ = 1 the
     /// matrix is [[4, 1], [1, 10]] and the step −(33, 24)/39. A zero Jacobian has none.
@@ -300,6 +297,9 @@ mod tests {
         assert!(gauss_newton_step(&zero, &r, 0.0).is_none());
     }
 
+    /// Linear least squares r = A s − b, whose minimum (A's normal equations, solved by
+    /// hand: s = (0.25, 0.75)) lies inside the box: forward differences are exact on a
+    /// linear map, so a few damped Gauss–Newton steps land on it.
     #[test]
     fn levenberg_marquardt_solves_a_linear_least_squares_problem() {
         // A = [[1, 0], [0, 2], [1, 1]], b = A·(0.25, 0.75) + a residual orthogonal to A's
