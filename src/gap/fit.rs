@@ -778,10 +778,10 @@ impl<'a> FitContext<'a> {
         &self,
         fit: &Fit,
         knob: usize,
+        others: &[usize],
         x: f64,
         jac: Option<&nalgebra::DMatrix<f64>>,
     ) -> Result<f64, GapError> {
-        let others: Vec<usize> = fit.active.iter().copied().filter(|k| *k != knob).collect();
         let mut base = fit.point.clone();
         base[knob] = Some(x);
         let walked = |point: &Point| -> Result<(f64, Vec<SimMetrics>), GapError> {
@@ -797,8 +797,8 @@ impl<'a> FitContext<'a> {
         }
         let point = {
             let sur = self.sur();
-            let obj = self.objective(&sur, &others, &base, &fit.correction);
-            let s0 = self.unit_of(&others, &base);
+            let obj = self.objective(&sur, others, &base, &fit.correction);
+            let s0 = self.unit_of(others, &base);
             let (s, _) = minimize(&obj, std::slice::from_ref(&s0), 0.05);
             obj.point(&s)
         };
@@ -820,12 +820,12 @@ impl<'a> FitContext<'a> {
                 break;
             };
             let unit: Vec<f64> = self
-                .unit_of(&others, &at)
+                .unit_of(others, &at)
                 .iter()
                 .zip(&delta)
                 .map(|(u, d)| (u + d).clamp(0.0, 1.0))
                 .collect();
-            let next = self.knobs.point_at(&at, &others, &unit);
+            let next = self.knobs.point_at(&at, others, &unit);
             let tried = walked(&next)?;
             if tried.0 >= best.0 - 1e-9 {
                 break;
@@ -856,7 +856,7 @@ impl<'a> FitContext<'a> {
         let limit = fit.chi2 + 3.841_458_820_694_124 * phi.max(1.0);
         let (lo, open_below, hi, open_above) =
             bracket_profile(fit.unit[pos], fit.chi2, limit, |t| {
-                self.real_chi2_with(fit, knob, k.from_unit(t), jac.as_ref())
+                self.real_chi2_with(fit, knob, &others, k.from_unit(t), jac.as_ref())
             })?;
         Ok(Some(ProfileInterval {
             lo: k.from_unit(lo),
