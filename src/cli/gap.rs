@@ -151,61 +151,131 @@ pub struct DiagnoseArgs {
     /// Figure of the standardised residuals per condition, before and after (SVG or PNG).
     #[arg(long, value_name = "FILE")]
     pub plot: Option<PathBuf>,
-    /// Experimental: rounds of the exchange step after forward selection. The answer's
-    /// model is compared with its same-size neighbours (other pairs of knobs, or one knob
-    /// exchanged); a better one replaces it only if its knobs form a chain every rule
-    /// accepts, and one that fits alike makes the exchanged knobs "not told apart". Off (0):
-    /// on 165 benchmark cases it found 3 more pairs and removed 4 wrong names, but made one
-    /// (reports/gap-benchmark.md, "The exchange step, measured").
-    #[arg(long, default_value_t = 0, value_parser = clap::value_parser!(u8).range(0..=4))]
-    pub exchange_rounds: u8,
+    #[command(flatten)]
+    pub selection: SelectionArgs,
+}
+
+/// The selection's rules (`gap diagnose`, and every case of `gap benchmark`). By default
+/// four rules judge the chain again once it is built: one exchange round, the look-ahead
+/// check, the deferred recalibration test and the step's look-alikes compared at the end;
+/// the flags below switch each off, or add an experimental one.
+#[derive(Args, Debug, Clone, Default)]
+#[command(next_help_heading = "Selection rules")]
+pub struct SelectionArgs {
+    /// Forward selection and the backward pass alone, without the four rules that are on by
+    /// default (the selection before 2026-11-28, which the reports' older runs used): to
+    /// compare a rule with the selection without it. --exchange-rounds still applies.
+    #[arg(long)]
+    pub plain_selection: bool,
+    /// Rounds of the exchange step after the backward pass. The answer's model is compared
+    /// with its same-size neighbours (other pairs of knobs, or one knob exchanged); a better
+    /// one replaces it only if its knobs form a chain every rule accepts, and one that fits
+    /// alike makes the exchanged knobs "not told apart". Default 1 (0 with
+    /// --plain-selection); measured in reports/gap-benchmark.md.
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u8).range(0..=4))]
+    pub exchange_rounds: Option<u8>,
+    /// Without the look-ahead check. The check weighs each named knob at the answer's size
+    /// (the answer against the best model with that knob exchanged for another) and one size
+    /// up; a named knob that a model without it fits better than one with it by the
+    /// identification distance, held out too, is not named (ambiguous): a look-alike that
+    /// won the first step. It only takes names away.
+    #[arg(long, conflicts_with = "look_ahead")]
+    pub no_look_ahead: bool,
+    /// With --plain-selection: the look-ahead check alone (on by default).
+    #[arg(long)]
+    pub look_ahead: bool,
+    /// Without the deferred recalibration test. With it, when no knob passes every rule at a
+    /// step, an effect that fails only the test against the recalibration is taken and that
+    /// test is made at the end with every other effect of the answer in (if it fails then,
+    /// the search is made again without deferring it). Tested alone, the first of two causes
+    /// carries the second one's misfit in the over-dispersion that scales its test.
+    #[arg(long, conflicts_with = "deferred_recalibration")]
+    pub no_deferred_recalibration: bool,
+    /// With --plain-selection: the deferred recalibration test alone (on by default).
+    #[arg(long)]
+    pub deferred_recalibration: bool,
+    /// Without the end comparison of look-alikes. With it, the look-alikes a step could not
+    /// tell its knob from are compared again in the final model (the knob exchanged for each,
+    /// walked): at the step a still-missing second cause widens the identification distance
+    /// by its misfit; with every cause of the answer in, the trials may tell them apart.
+    #[arg(long, conflicts_with = "rivals_at_end")]
+    pub no_rivals_at_end: bool,
+    /// With --plain-selection: the end comparison of look-alikes alone (on by default).
+    #[arg(long)]
+    pub rivals_at_end: bool,
     /// Experimental: the joint step. When no single knob passes and the model is still
     /// beyond noise, every pair of knobs is fitted together and the best pair is taken if
     /// it passes a 2-dof test at α over the number of pairs and each of its knobs is
-    /// needed beside the other. Off: with --exchange-rounds 1 --look-ahead it named both
+    /// needed beside the other. Off: with the exchange step and the look-ahead it named both
     /// causes of 3 more benchmark pairs and nothing on 19 Drake and parameter-error cases,
     /// but on another noise draw of one pair it named a look-alike (viscous damping for
     /// Coulomb friction) and a wrong parameter (reports/gap-benchmark.md).
     #[arg(long)]
     pub joint_step: bool,
-    /// Experimental: the look-ahead check. Each named knob is weighed at the answer's size
-    /// (the answer against the best model with that knob exchanged for another) and one
-    /// size up (the best model with one knob more that keeps it against the best in which
-    /// it is exchanged for a knob significant alone, and one more added). A named knob that
-    /// a model without it fits better than one with it by the identification distance, held
-    /// out too, is not named (ambiguous): a look-alike that won the first step. It only
-    /// takes names away.
-    #[arg(long)]
-    pub look_ahead: bool,
     /// Experimental: Levenberg–Marquardt on walks for the two fits the call rule weighs, the
     /// recalibration of every uncertain parameter and an effect with it (about a dozen
-    /// knobs, which interact where the surrogate cannot see it). Without it those fits can
-    /// stop far above their best. Off: on every noisy benchmark pair it named both causes
-    /// of 2 more pairs and of 4 fewer, since the recalibration gains more than an effect
-    /// does (reports/gap-benchmark.md, fifth session); 1.9× the walks.
+    /// knobs, which interact where the surrogate cannot see it). Off: on every noisy
+    /// benchmark pair it named both causes of 2 more pairs and of 4 fewer, since the
+    /// recalibration gains more than an effect does (reports/gap-benchmark.md, fifth
+    /// session); 1.9× the walks.
     #[arg(long)]
     pub walked_lm: bool,
-    /// Experimental: when no knob passes every rule at a step, take an effect that fails
-    /// only the test against the recalibration, and make that test at the end with every
-    /// other effect of the answer in (if it fails then, the search is made again without
-    /// deferring it: the answer the default would give). Tested
-    /// alone, the first of two causes carries the second one's misfit in the
-    /// over-dispersion that scales its test, so it fails where both together pass.
-    #[arg(long)]
-    pub deferred_recalibration: bool,
-    /// Experimental: compare the look-alikes a step could not tell its knob from again in
-    /// the final model (the knob exchanged for each, walked). At the step a still-missing
-    /// second cause widens the identification distance by its misfit; with every cause of
-    /// the answer in, the trials may tell them apart.
-    #[arg(long)]
-    pub rivals_at_end: bool,
     /// Experimental: find every named knob's look-alikes again in the final model, among
     /// all knobs outside it (the knob exchanged for each, screened, the nearest walked):
-    /// one within the identification distance makes the knob ambiguous, as at a step. A
-    /// look-alike a step could not see (its second cause still missing) then shows.
-    /// Supersedes --rivals-at-end: flags are cleared only when no named knob has one.
+    /// one within the identification distance makes the knob ambiguous, as at a step.
+    /// Supersedes the end comparison of the step's look-alikes: flags are cleared only when
+    /// no named knob has one.
     #[arg(long)]
     pub look_alikes_at_end: bool,
+}
+
+impl SelectionArgs {
+    /// The selection's options these flags ask for.
+    pub fn options(&self) -> gap::select::SelectOptions {
+        let base = if self.plain_selection {
+            gap::select::SelectOptions::plain()
+        } else {
+            gap::select::SelectOptions::default()
+        };
+        gap::select::SelectOptions {
+            exchange_rounds: self
+                .exchange_rounds
+                .map_or(base.exchange_rounds, usize::from),
+            look_ahead: (base.look_ahead || self.look_ahead) && !self.no_look_ahead,
+            deferred_recalibration: (base.deferred_recalibration || self.deferred_recalibration)
+                && !self.no_deferred_recalibration,
+            rivals_at_end: (base.rivals_at_end || self.rivals_at_end) && !self.no_rivals_at_end,
+            joint_step: self.joint_step,
+            walked_lm: self.walked_lm,
+            look_alikes_at_end: self.look_alikes_at_end,
+            ..base
+        }
+    }
+
+    /// The flags as given, for a report's command line.
+    fn flags(&self) -> String {
+        let mut f = String::new();
+        let mut flag = |on: bool, name: &str| {
+            if on {
+                f.push_str(" --");
+                f.push_str(name);
+            }
+        };
+        flag(self.plain_selection, "plain-selection");
+        flag(self.no_look_ahead, "no-look-ahead");
+        flag(self.look_ahead, "look-ahead");
+        flag(self.no_deferred_recalibration, "no-deferred-recalibration");
+        flag(self.deferred_recalibration, "deferred-recalibration");
+        flag(self.no_rivals_at_end, "no-rivals-at-end");
+        flag(self.rivals_at_end, "rivals-at-end");
+        flag(self.joint_step, "joint-step");
+        flag(self.walked_lm, "walked-lm");
+        flag(self.look_alikes_at_end, "look-alikes-at-end");
+        if let Some(n) = self.exchange_rounds {
+            f.push_str(&format!(" --exchange-rounds {n}"));
+        }
+        f
+    }
 }
 
 #[derive(Args, Debug)]
@@ -356,38 +426,10 @@ pub struct BenchmarkArgs {
     /// 0 leaves the suite out (--quick's default; otherwise 100).
     #[arg(long, value_name = "N")]
     pub one_robot_nulls: Option<u64>,
-    /// Run every case with this many rounds of the diagnosis' experimental exchange step
-    /// (`gap diagnose --exchange-rounds`), to measure it. Another benchmark: use its own
-    /// points file.
-    #[arg(long, default_value_t = 0, value_parser = clap::value_parser!(u8).range(0..=4))]
-    pub exchange_rounds: u8,
-    /// Run every case with the diagnosis' experimental look-ahead check (`gap diagnose
-    /// --look-ahead`), to measure it. Another benchmark: use its own points file.
-    #[arg(long)]
-    pub look_ahead: bool,
-    /// Run every case with the diagnosis' experimental joint step (`gap diagnose
-    /// --joint-step`), to measure it. Another benchmark: use its own points file.
-    #[arg(long)]
-    pub joint_step: bool,
-    /// Run every case with the diagnosis' experimental Levenberg–Marquardt on walks (`gap
-    /// diagnose --walked-lm`), to measure it. Another benchmark: use its own points file.
-    #[arg(long)]
-    pub walked_lm: bool,
-    /// Run every case with the diagnosis' experimental deferred recalibration test (`gap
-    /// diagnose --deferred-recalibration`), to measure it. Another benchmark: use its own
-    /// points file.
-    #[arg(long)]
-    pub deferred_recalibration: bool,
-    /// Run every case with the diagnosis' experimental end check of look-alikes (`gap
-    /// diagnose --rivals-at-end`), to measure it. Another benchmark: use its own points
-    /// file.
-    #[arg(long)]
-    pub rivals_at_end: bool,
-    /// Run every case with the diagnosis' experimental end search for look-alikes (`gap
-    /// diagnose --look-alikes-at-end`), to measure it. Another benchmark: use its own
-    /// points file.
-    #[arg(long)]
-    pub look_alikes_at_end: bool,
+    /// The selection's rules of every case (as `gap diagnose`). A run with other rules than
+    /// the default is another benchmark: use its own points file.
+    #[command(flatten)]
+    pub selection: SelectionArgs,
     /// Noise levels (relative sd) of the null and single-effect cases.
     #[arg(long, value_delimiter = ',')]
     pub noise: Option<Vec<f64>>,
@@ -695,16 +737,7 @@ fn diagnose(a: &DiagnoseArgs) -> anyhow::Result<ExitCode> {
         default_relative_sd: a.default_sd,
         alpha: a.alpha,
         calibrate: !a.no_calibration,
-        select: gap::select::SelectOptions {
-            exchange_rounds: usize::from(a.exchange_rounds),
-            joint_step: a.joint_step,
-            look_ahead: a.look_ahead,
-            walked_lm: a.walked_lm,
-            deferred_recalibration: a.deferred_recalibration,
-            rivals_at_end: a.rivals_at_end,
-            look_alikes_at_end: a.look_alikes_at_end,
-            ..gap::select::SelectOptions::default()
-        },
+        select: a.selection.options(),
         ..DiagnoseOptions::default()
     };
     let pb = Progress::Spinner(indicatif::ProgressBar::new_spinner());
@@ -792,13 +825,7 @@ fn benchmark(a: &BenchmarkArgs) -> anyhow::Result<ExitCode> {
     if let Some(n) = a.one_robot_nulls {
         opts.one_robot_null_cases = n;
     }
-    opts.exchange_rounds = usize::from(a.exchange_rounds);
-    opts.look_ahead = a.look_ahead;
-    opts.joint_step = a.joint_step;
-    opts.walked_lm = a.walked_lm;
-    opts.deferred_recalibration = a.deferred_recalibration;
-    opts.rivals_at_end = a.rivals_at_end;
-    opts.look_alikes_at_end = a.look_alikes_at_end;
+    opts.set_selection(&a.selection.options());
     if let Some(n) = &a.noise {
         if let Some(bad) = n.iter().find(|x| !(**x > 0.0 && **x < 1.0)) {
             anyhow::bail!("--noise {bad}: each level must be a fraction in (0, 1)");
@@ -889,27 +916,7 @@ fn benchmark(a: &BenchmarkArgs) -> anyhow::Result<ExitCode> {
     if let Some(n) = a.one_robot_nulls {
         command.push_str(&format!(" --one-robot-nulls {n}"));
     }
-    if a.exchange_rounds > 0 {
-        command.push_str(&format!(" --exchange-rounds {}", a.exchange_rounds));
-    }
-    if a.look_ahead {
-        command.push_str(" --look-ahead");
-    }
-    if a.joint_step {
-        command.push_str(" --joint-step");
-    }
-    if a.walked_lm {
-        command.push_str(" --walked-lm");
-    }
-    if a.deferred_recalibration {
-        command.push_str(" --deferred-recalibration");
-    }
-    if a.rivals_at_end {
-        command.push_str(" --rivals-at-end");
-    }
-    if a.look_alikes_at_end {
-        command.push_str(" --look-alikes-at-end");
-    }
+    command.push_str(&a.selection.flags());
     if !a.effects.is_empty() {
         command.push_str(&format!(" --effects {}", a.effects.join(",")));
     }

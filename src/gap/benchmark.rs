@@ -84,37 +84,24 @@ pub struct BenchmarkOptions {
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub compound_errors: Vec<Vec<(String, f64)>>,
     pub effects: Vec<String>,
-    /// Rounds of the selection's exchange step in every case (`SelectOptions::
-    /// exchange_rounds`; 0, the diagnosis' default). Part of the points file's signature
-    /// when not 0: a run with the exchange step is another benchmark.
+    /// The selection's rules of every case (`SelectOptions`, set by `set_selection`). A
+    /// rule is part of the points file's signature when it is on (serde skips what is off):
+    /// a run with other rules is another benchmark and cannot resume this one's file. The
+    /// standard run has the diagnosis' default, the four rules on (exchange_rounds 1,
+    /// look_ahead, deferred_recalibration, rivals_at_end); a run with all off has the
+    /// signature of the points files written before they were the default.
     #[serde(default, skip_serializing_if = "is_zero")]
     pub exchange_rounds: usize,
-    /// Every case with the selection's look-ahead check (`SelectOptions::look_ahead`; off,
-    /// the diagnosis' default). Part of the signature when on: another benchmark.
     #[serde(default, skip_serializing_if = "is_false")]
     pub look_ahead: bool,
-    /// Every case with the selection's joint step (`SelectOptions::joint_step`; off, the
-    /// diagnosis' default). Part of the signature when on: another benchmark.
     #[serde(default, skip_serializing_if = "is_false")]
     pub joint_step: bool,
-    /// Every case with Levenberg–Marquardt on walks for the recalibration test
-    /// (`SelectOptions::walked_lm`; off, the diagnosis' default). Part of the signature when
-    /// on: another benchmark.
     #[serde(default, skip_serializing_if = "is_false")]
     pub walked_lm: bool,
-    /// Every case with the recalibration test deferred for an effect that passes every
-    /// other rule when no knob passes them all (`SelectOptions::deferred_recalibration`;
-    /// off, the diagnosis' default). Part of the signature when on: another benchmark.
     #[serde(default, skip_serializing_if = "is_false")]
     pub deferred_recalibration: bool,
-    /// Every case with the step's look-alikes compared again in the final model
-    /// (`SelectOptions::rivals_at_end`; off, the diagnosis' default). Part of the signature
-    /// when on: another benchmark.
     #[serde(default, skip_serializing_if = "is_false")]
     pub rivals_at_end: bool,
-    /// Every case with every named knob's look-alikes found again in the final model
-    /// (`SelectOptions::look_alikes_at_end`; off, the diagnosis' default). Part of the
-    /// signature when on: another benchmark.
     #[serde(default, skip_serializing_if = "is_false")]
     pub look_alikes_at_end: bool,
 }
@@ -128,8 +115,7 @@ fn is_zero(n: &usize) -> bool {
 }
 
 impl BenchmarkOptions {
-    /// The selection's options of every case: the default ones plus the experimental rules
-    /// this run measures.
+    /// The selection's options of every case.
     fn select_options(&self) -> SelectOptions {
         SelectOptions {
             exchange_rounds: self.exchange_rounds,
@@ -143,12 +129,23 @@ impl BenchmarkOptions {
         }
     }
 
+    /// Run every case with these rules of the selection (its thresholds stay the default).
+    pub fn set_selection(&mut self, s: &SelectOptions) {
+        self.exchange_rounds = s.exchange_rounds;
+        self.look_ahead = s.look_ahead;
+        self.joint_step = s.joint_step;
+        self.walked_lm = s.walked_lm;
+        self.deferred_recalibration = s.deferred_recalibration;
+        self.rivals_at_end = s.rivals_at_end;
+        self.look_alikes_at_end = s.look_alikes_at_end;
+    }
+
     /// The benchmark for a design (the bundled Mugatu's parameter errors).
     pub fn standard(design: &str) -> BenchmarkOptions {
         let p = |v: &[(&str, f64)]| -> Vec<(String, f64)> {
             v.iter().map(|(k, x)| (k.to_string(), *x)).collect()
         };
-        BenchmarkOptions {
+        let mut o = BenchmarkOptions {
             design: design.to_string(),
             noise_levels: vec![0.01, 0.03, 0.05, 0.10],
             null_cases: 300,
@@ -210,7 +207,9 @@ impl BenchmarkOptions {
             deferred_recalibration: false,
             rivals_at_end: false,
             look_alikes_at_end: false,
-        }
+        };
+        o.set_selection(&SelectOptions::default());
+        o
     }
 }
 
@@ -392,6 +391,8 @@ pub fn thresholds(
         calibrate,
         explanations: false,
         identifiability: true,
+        // The thresholds do not depend on the selection; its plain rules are the quickest.
+        select: SelectOptions::plain(),
         ..DiagnoseOptions::default()
     };
     Ok(

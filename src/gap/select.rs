@@ -15,16 +15,20 @@
 //!   nuisance, adding the effect is still significant. A knob that makes the model walk but
 //!   that a plausible error of the nominal parameters explains as well is not called.
 //!
-//! Each rule is checked on the surrogate first and confirmed with real walks. When no single
-//! knob passes and the model is still beyond noise, a joint step fits pairs of knobs together
-//! (`Selector::joint`: two causes neither of which passes alone). The steps form
-//! the chain ("hip friction: −55 %; + soft ground: −30 % more"); candidates within a small
-//! χ² of the chosen one are reported as not separable by these trials.
+//! Each rule is checked on the surrogate first and confirmed with real walks. The steps
+//! form the chain ("hip friction: −55 %; + soft ground: −30 % more"); candidates within a
+//! small χ² of the chosen one are reported as not separable by these trials.
 //!
-//! Two experimental options judge the first of two causes again once the second is in (at
-//! its own step the missing cause's misfit inflates the over-dispersion of every test):
-//! the recalibration test deferred to the end (`Selector::settle_deferred`), and the step's
-//! look-alikes compared again in the final model (`Selector::rivals_at_end`).
+//! By default (`SelectOptions::default`) four rules judge the chain again once it is built
+//! and pruned by the backward pass, since at its own step a still-missing cause's misfit
+//! inflates the over-dispersion of every test: one round of the exchange step
+//! (`Selector::swap`: the answer against its same-size neighbours), the look-ahead check (`Selector::look_ahead`:
+//! a look-alike that won the first step is unnamed), the recalibration test deferred to the
+//! end (`Selector::settle_deferred`) and the step's look-alikes compared again in the final
+//! model (`Selector::rivals_at_end`). `SelectOptions::plain` is the selection without them.
+//! The joint step (`Selector::joint`: pairs of knobs fitted together when no single knob
+//! passes), Levenberg–Marquardt on walks and the end search for look-alikes are
+//! experimental, off by default.
 
 use serde::Serialize;
 
@@ -44,11 +48,12 @@ pub struct SelectOptions {
     /// Recalibrate every uncertain parameter even when no effect needs the test (for the
     /// report's table); otherwise only when an effect is tested.
     pub always_recalibrate: bool,
-    /// Rounds of the exchange step after the backward pass (`Selector::swap`). 0, the
-    /// default: measured on 165 benchmark cases (reports/gap-benchmark.md, 2026-11-27) it
-    /// named both causes of 3 more pairs and removed 4 wrong names, but made one (Coulomb
-    /// friction exchanged for its look-alike, damping); on by default only after a full
-    /// benchmark run with it.
+    /// Rounds of the exchange step after the backward pass (`Selector::swap`). 1 by default
+    /// (with `look_ahead`, `deferred_recalibration` and `rivals_at_end`, since 2026-11-28):
+    /// measured on 849 benchmark cases with the other three (reports/gap-benchmark.md, eighth
+    /// session) they named nothing on 700 nulls, lost no right name and removed every
+    /// spurious knob of the noisy pairs. Alone, on 165 cases (2026-11-27), it once exchanged
+    /// Coulomb friction for its look-alike, damping.
     pub exchange_rounds: usize,
     /// Experimental: when no single knob passes and the model is beyond noise, fit pairs of
     /// knobs together (`Selector::joint`). Off by default. Tried on four expected-trial
@@ -65,8 +70,7 @@ pub struct SelectOptions {
     /// answer's size, or one size up, without it fits better than any with it is not
     /// named. It only takes names away. With the exchange step, on the benchmark's 42 pair
     /// cases (2026-11-27): no knob outside a pair named on noisy trials (0 / 21, was 2),
-    /// both named as with the exchange alone, 2.2× the walks of the default. Off by
-    /// default until the other kinds of case have been run with it.
+    /// both named as with the exchange alone, 2.2× the walks. On by default.
     pub look_ahead: bool,
     /// Levenberg–Marquardt on walks (`FitContext::levenberg_marquardt`) for the two fits
     /// the call rule weighs against each other: the recalibration of every uncertain
@@ -77,23 +81,23 @@ pub struct SelectOptions {
     /// both causes of 2 more pairs and of 4 fewer (the recalibration gains more than the
     /// effect does), at 1.9× the walks.
     pub walked_lm: bool,
-    /// Experimental: an effect that passes every rule of its step but the test against the
+    /// An effect that passes every rule of its step but the test against the
     /// recalibration is taken anyway when no knob passes them all, and tested against the
     /// recalibration at the end, with every other effect of the answer in
-    /// (`Selector::settle_deferred`). With the first of two causes tested alone, the second
+    /// (`Selector::settle_deferred`). On by default. With the first of two causes tested alone, the second
     /// one's misfit inflates the over-dispersion that scales its LR, and a dozen parameters
     /// absorb part of it: the test is weakest exactly where a second cause is missing.
     /// Measured with `rivals_at_end` on every noisy benchmark pair (reports/gap-benchmark.md,
     /// sixth session): both causes named in 14/21 (default 11/21, no pair lost), no new
     /// wrong name there or on 40 parameter-error, compound and Drake cases; 1.3× the walks
-    /// on the pairs. Off until the whole benchmark has run with it.
+    /// on the pairs.
     pub deferred_recalibration: bool,
-    /// Experimental: the look-alikes a step could not tell its knob from are compared again
+    /// The look-alikes a step could not tell its knob from are compared again
     /// in the final model (`Selector::rivals_at_end`): the knob exchanged for each, walked.
     /// At the step, with a second cause still missing, the over-dispersion widens the
     /// identification distance by as much as its misfit (φ ≈ 20 on the benchmark's pairs),
     /// so most near candidates are "not separable"; with both causes in, φ ≈ 1. Measured
-    /// with `deferred_recalibration` (above); off until the whole benchmark has run with it.
+    /// with `deferred_recalibration` (above). On by default.
     pub rivals_at_end: bool,
     /// Experimental: every named knob's look-alikes found again in the final model, among
     /// all knobs outside it (`Selector::look_alikes_at_end`), by the step's own rule: the
@@ -108,7 +112,25 @@ pub struct SelectOptions {
 }
 
 impl Default for SelectOptions {
+    /// The selection `survey gap diagnose` runs: forward selection and the backward pass,
+    /// one exchange round, the look-ahead check, the deferred recalibration test and the
+    /// step's look-alikes compared again at the end. Their measurements are in the fields'
+    /// comments and in reports/gap-benchmark.md (eighth session: the whole benchmark).
     fn default() -> Self {
+        SelectOptions {
+            exchange_rounds: 1,
+            look_ahead: true,
+            deferred_recalibration: true,
+            rivals_at_end: true,
+            ..SelectOptions::plain()
+        }
+    }
+}
+
+impl SelectOptions {
+    /// Forward selection and the backward pass alone: the default before 2026-11-28, kept
+    /// to compare a rule with the selection without it (the reports' older runs used it).
+    pub fn plain() -> Self {
         SelectOptions {
             alpha: 0.001,
             material_shrink: 0.10,

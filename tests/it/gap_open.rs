@@ -358,7 +358,7 @@ fn assert_recovered(d: &Diagnosis, truths: &[(&str, f64)], tol: f64) {
 fn walked_levenberg_marquardt_lets_a_pair_beat_a_dozen_parameter_recalibration() {
     let select = SelectOptions {
         walked_lm: true,
-        ..SelectOptions::default()
+        ..SelectOptions::plain()
     };
     let d = diagnose_committed(
         "backlash-coulomb-3pct-seed0.csv",
@@ -400,22 +400,23 @@ fn diagnose_committed(
         .0
 }
 
-/// The diagnoses of committed trials by default and with `select` (one walk cache: the
-/// second reuses the first's walks).
-fn default_and_with(file: &str, effects: &[&str], select: SelectOptions) -> (Diagnosis, Diagnosis) {
-    let (plain, mut with) = default_and_each(file, effects, &[select]);
+/// The diagnoses of committed trials with the plain selection (`SelectOptions::plain`, the
+/// default before 2026-11-28) and with `select` (one walk cache: the second reuses the
+/// first's walks).
+fn plain_and_with(file: &str, effects: &[&str], select: SelectOptions) -> (Diagnosis, Diagnosis) {
+    let (plain, mut with) = plain_and_each(file, effects, &[select]);
     (plain, with.remove(0))
 }
 
-/// The diagnoses of committed trials by default and with each of `selects`, on one walk
-/// cache.
-fn default_and_each(
+/// The diagnoses of committed trials with the plain selection and with each of `selects`,
+/// on one walk cache.
+fn plain_and_each(
     file: &str,
     effects: &[&str],
     selects: &[SelectOptions],
 ) -> (Diagnosis, Vec<Diagnosis>) {
     let cache = SimCache::default();
-    let plain = diagnose_committed(file, effects, &SelectOptions::default(), &cache);
+    let plain = diagnose_committed(file, effects, &SelectOptions::plain(), &cache);
     let with = selects
         .iter()
         .map(|select| diagnose_committed(file, effects, select, &cache))
@@ -461,11 +462,12 @@ fn assert_pair_named(d: &Diagnosis, truths: [(&str, f64); 2]) {
 /// called, and the answer was "partly explained, nothing named" (measured 2026-11-27 with
 /// every candidate). With the test deferred to the end (`deferred_recalibration`), soft
 /// ground is taken, the motor line follows and passes, and soft ground then beats the
-/// recalibration with the motor line in (p = 8e-34): both named within 10 %. The default
-/// answer on the same trials is checked too: without the option the pair is not named.
+/// recalibration with the motor line in (p = 8e-34): both named within 10 %. The plain
+/// selection's answer on the same trials is checked too: without the option the pair is
+/// not named. The default selection (this option among the four rules) names both.
 #[test]
 fn a_deferred_recalibration_test_names_both_causes_of_a_pair() {
-    let (plain, d) = default_and_with(
+    let (plain, with) = plain_and_each(
         "motor-soft-3pct-bench.csv",
         &[
             "soft_ground",
@@ -473,20 +475,25 @@ fn a_deferred_recalibration_test_names_both_causes_of_a_pair() {
             "hip_coulomb_friction",
             "hip_viscous_damping",
         ],
-        SelectOptions {
-            deferred_recalibration: true,
-            ..SelectOptions::default()
-        },
+        &[
+            SelectOptions {
+                deferred_recalibration: true,
+                ..SelectOptions::plain()
+            },
+            SelectOptions::default(),
+        ],
     );
     assert!(
         names(&plain).1.len() < 2,
-        "the default names both: {}",
+        "the plain selection names both: {}",
         plain.answer.statement
     );
-    assert_pair_named(
-        &d,
-        [("motor_torque_speed", 3.6834), ("soft_ground", 3.1121e6)],
-    );
+    for d in &with {
+        assert_pair_named(
+            d,
+            [("motor_torque_speed", 3.6834), ("soft_ground", 3.1121e6)],
+        );
+    }
 }
 
 /// The benchmark's noisy pair "backlash + hip viscous damping" (2× thresholds, 3 % noise,
@@ -498,10 +505,11 @@ fn a_deferred_recalibration_test_names_both_causes_of_a_pair() {
 /// against a distance of 6.6: `rivals_at_end` tells them apart and both causes are named,
 /// within 10 %. `look_alikes_at_end`, which searches every knob outside the answer, finds
 /// no look-alike of either named knob there and clears the flag too. Without them the
-/// default leaves damping unnamed on the same trials.
+/// plain selection leaves damping unnamed on the same trials; the default selection (with
+/// `rivals_at_end` among its four rules) names both.
 #[test]
 fn look_alikes_compared_again_in_the_final_model_name_both_causes_of_a_pair() {
-    let (plain, with) = default_and_each(
+    let (plain, with) = plain_and_each(
         "backlash-damping-3pct-bench.csv",
         &[
             "hip_backlash",
@@ -511,17 +519,18 @@ fn look_alikes_compared_again_in_the_final_model_name_both_causes_of_a_pair() {
         &[
             SelectOptions {
                 rivals_at_end: true,
-                ..SelectOptions::default()
+                ..SelectOptions::plain()
             },
             SelectOptions {
                 look_alikes_at_end: true,
-                ..SelectOptions::default()
+                ..SelectOptions::plain()
             },
+            SelectOptions::default(),
         ],
     );
     assert!(
         !names(&plain).1.contains(&"hip_viscous_damping".to_string()),
-        "the default names damping: {}",
+        "the plain selection names damping: {}",
         plain.answer.statement
     );
     for d in &with {
@@ -592,17 +601,17 @@ fn a_look_alike_found_again_in_the_final_model_unnames_a_stand_in() {
         "hip_viscous_damping",
         "motor_torque_speed",
     ];
-    let (plain, d) = default_and_with(
+    let (plain, d) = plain_and_with(
         "coulomb-motor-3pct-bench.csv",
         &effects,
         SelectOptions {
             look_alikes_at_end: true,
-            ..SelectOptions::default()
+            ..SelectOptions::plain()
         },
     );
     assert!(
         names(&plain).1.contains(&"hip_viscous_damping".to_string()),
-        "the default does not name damping: {}",
+        "the plain selection does not name damping: {}",
         plain.answer.statement
     );
     let (params, named) = names(&d);
@@ -636,7 +645,7 @@ fn the_look_ahead_check_unnames_a_look_alike_that_won_the_first_step() {
     ];
     let look = SelectOptions {
         look_ahead: true,
-        ..SelectOptions::default()
+        ..SelectOptions::plain()
     };
     let pair = [
         ("friction_coefficient", 0.34),
@@ -650,7 +659,7 @@ fn the_look_ahead_check_unnames_a_look_alike_that_won_the_first_step() {
         None,
         &candidates,
         false,
-        SelectOptions::default(),
+        SelectOptions::plain(),
     );
     assert_eq!(
         names(&plain).1,
@@ -703,7 +712,7 @@ fn the_look_ahead_check_unnames_a_look_alike_that_won_the_first_step() {
 fn the_look_ahead_check_keeps_a_true_effect_beside_an_undeclared_error() {
     let look = SelectOptions {
         look_ahead: true,
-        ..SelectOptions::default()
+        ..SelectOptions::plain()
     };
     for seed in [None, Some(1)] {
         let d = case_with(
@@ -1094,63 +1103,72 @@ fn explore_says_cannot_tell_when_its_sample_is_too_sparse() {
     assert!(stdout(&o).contains("**Cannot tell"), "{}", stdout(&o));
 }
 
-/// The experimental rules (the exchange step's rounds, the look-ahead check, the joint step,
-/// Levenberg–Marquardt on walks, the deferred recalibration test, look-alikes at the end)
-/// are part of a benchmark's signature only when the run uses them: the committed points
-/// file (written without them) stays the standard run's, and a run with any of them cannot
-/// be resumed into it.
+/// The selection's rules are part of a benchmark's signature when the run uses them. The
+/// standard run has the diagnosis' default (one exchange round, the look-ahead check, the
+/// deferred recalibration test, look-alikes compared at the end), as the committed points
+/// file does; a run with the plain selection has the signature of the points files written
+/// before the four were the default (`reports/gap-benchmark-plain.points.csv`); a run with
+/// any other set of rules cannot be resumed into the committed file.
 #[test]
-fn a_benchmark_with_an_experimental_rule_is_another_benchmark() {
+fn a_benchmark_with_other_selection_rules_is_another_benchmark() {
     let mut opts = BenchmarkOptions::standard("mugatu");
-    let plain = serde_json::to_string(&opts).expect("options serialise");
-    assert!(!plain.contains("exchange_rounds"), "{plain}");
-    assert!(!plain.contains("look_ahead"), "{plain}");
-    assert!(!plain.contains("joint_step"), "{plain}");
-    assert!(!plain.contains("walked_lm"), "{plain}");
-    assert!(!plain.contains("deferred_recalibration"), "{plain}");
-    assert!(!plain.contains("rivals_at_end"), "{plain}");
-    assert!(!plain.contains("look_alikes_at_end"), "{plain}");
+    let standard = serde_json::to_string(&opts).expect("options serialise");
+    for on in [
+        "\"exchange_rounds\":1",
+        "\"look_ahead\":true",
+        "\"deferred_recalibration\":true",
+        "\"rivals_at_end\":true",
+    ] {
+        assert!(standard.contains(on), "{on}: {standard}");
+    }
+    for off in ["joint_step", "walked_lm", "look_alikes_at_end"] {
+        assert!(!standard.contains(off), "{off}: {standard}");
+    }
+    let tail = |json: &str| {
+        // The rules close the options' object: compare from the first of them on.
+        json[json.find("\"effects\"").expect("effects")..].to_string()
+    };
     let committed = std::fs::read_to_string(repo().join("reports/gap-benchmark.points.csv"))
         .expect("committed points file");
     let header = committed.lines().next().unwrap_or_default();
     assert!(header.contains("\"one_robot_null_cases\":100"), "{header}");
-    assert!(!header.contains("exchange_rounds"), "{header}");
-    assert!(!header.contains("look_ahead"), "{header}");
-    assert!(!header.contains("joint_step"), "{header}");
-    assert!(!header.contains("walked_lm"), "{header}");
-    assert!(!header.contains("deferred_recalibration"), "{header}");
-    assert!(!header.contains("rivals_at_end"), "{header}");
-    assert!(!header.contains("look_alikes_at_end"), "{header}");
-    opts.exchange_rounds = 1;
-    opts.look_ahead = true;
-    opts.joint_step = true;
-    opts.walked_lm = true;
-    opts.deferred_recalibration = true;
-    opts.rivals_at_end = true;
-    opts.look_alikes_at_end = true;
+    assert!(
+        header.ends_with(&format!("{}]", tail(&standard))),
+        "{header}"
+    );
+    opts.set_selection(&SelectOptions::plain());
+    let plain = serde_json::to_string(&opts).expect("options serialise");
+    assert!(plain.ends_with("\"effects\":[]}"), "{plain}");
+    let plain_file = std::fs::read_to_string(repo().join("reports/gap-benchmark-plain.points.csv"))
+        .expect("the plain selection's points file");
+    let plain_header = plain_file.lines().next().unwrap_or_default();
+    assert!(plain_header.ends_with("\"effects\":[]}]"), "{plain_header}");
+    opts.set_selection(&SelectOptions {
+        joint_step: true,
+        walked_lm: true,
+        look_alikes_at_end: true,
+        ..SelectOptions::default()
+    });
     let with = serde_json::to_string(&opts).expect("options serialise");
-    assert!(with.contains("\"exchange_rounds\":1"), "{with}");
-    assert!(with.contains("\"look_ahead\":true"), "{with}");
     assert!(with.contains("\"joint_step\":true"), "{with}");
     assert!(with.contains("\"walked_lm\":true"), "{with}");
-    assert!(with.contains("\"deferred_recalibration\":true"), "{with}");
-    assert!(with.contains("\"rivals_at_end\":true"), "{with}");
     assert!(with.contains("\"look_alikes_at_end\":true"), "{with}");
     // The real binary, resuming a copy of the committed points file with the standard run's
-    // options plus one experimental rule: refused at once (before the planning's minutes),
-    // naming the file, and the file left as it was.
+    // options but one rule switched: refused at once (before the planning's minutes), naming
+    // the file, and the file left as it was.
     let dir = tempfile::tempdir().expect("tempdir");
     let points = dir.path().join("gap-benchmark.points.csv");
     std::fs::write(&points, &committed).expect("copy");
     let points_arg = points.display().to_string();
     let out_arg = dir.path().join("out").display().to_string();
     for rule in [
-        &["--look-ahead"][..],
-        &["--exchange-rounds", "1"],
+        &["--plain-selection"][..],
+        &["--no-look-ahead"],
+        &["--exchange-rounds", "0"],
         &["--joint-step"],
         &["--walked-lm"],
-        &["--deferred-recalibration"],
-        &["--rivals-at-end"],
+        &["--no-deferred-recalibration"],
+        &["--no-rivals-at-end"],
         &["--look-alikes-at-end"],
     ] {
         let mut args = vec![
