@@ -453,7 +453,7 @@ impl Suite {
 pub struct Plan {
     pub cases: Vec<CaseSpec>,
     pub thresholds: BTreeMap<String, Vec<(String, Option<f64>)>>,
-    /// The selection's options of every case (the experimental rules the run asks for).
+    /// The selection's options of every case (the rules the run asks for).
     select: SelectOptions,
     suites: Vec<Suite>,
     drake: BTreeMap<String, (TrialSet, Vec<SimMetrics>)>,

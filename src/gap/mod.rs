@@ -13,8 +13,10 @@
 //!   with a per-model correction from real walks.
 //! * [`problem`] (the χ² cost), [`solver`] (Nelder–Mead, scans), [`fit`] (surrogate fit,
 //!   refinement with walks, held-out χ², profiles, consistency across groups).
-//! * [`select`]: forward selection with the call rules, the backward pass and an
-//!   (experimental, off by default) exchange step; [`diagnose`]: the answer;
+//! * [`select`]: forward selection with the call rules, the backward pass, and four rules
+//!   that judge the chain again with every cause of it in (on by default: an exchange
+//!   round, the look-ahead check, the deferred recalibration test, look-alikes compared at
+//!   the end); [`diagnose`]: the answer;
 //!   [`locate`]: where the gap lies; [`identify`]: detection and identification thresholds.
 //! * [`waveform`]: a robot's log (time, hip angle, attitude, torque) reduced to the Fourier
 //!   coefficients of its steady cycle, and their χ² against a simulated cycle;
