@@ -825,7 +825,7 @@ fn benchmark(a: &BenchmarkArgs) -> anyhow::Result<ExitCode> {
     if let Some(n) = a.one_robot_nulls {
         opts.one_robot_null_cases = n;
     }
-    opts.set_selection(&a.selection.options());
+    opts.select = a.selection.options();
     if let Some(n) = &a.noise {
         if let Some(bad) = n.iter().find(|x| !(**x > 0.0 && **x < 1.0)) {
             anyhow::bail!("--noise {bad}: each level must be a fraction in (0, 1)");

@@ -84,68 +84,23 @@ pub struct BenchmarkOptions {
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub compound_errors: Vec<Vec<(String, f64)>>,
     pub effects: Vec<String>,
-    /// The selection's rules of every case (`SelectOptions`, set by `set_selection`). A
-    /// rule is part of the points file's signature when it is on (serde skips what is off):
-    /// a run with other rules is another benchmark and cannot resume this one's file. The
-    /// standard run has the diagnosis' default, the four rules on (exchange_rounds 1,
-    /// look_ahead, deferred_recalibration, rivals_at_end); a run with all off has the
-    /// signature of the points files written before they were the default.
-    #[serde(default, skip_serializing_if = "is_zero")]
-    pub exchange_rounds: usize,
-    #[serde(default, skip_serializing_if = "is_false")]
-    pub look_ahead: bool,
-    #[serde(default, skip_serializing_if = "is_false")]
-    pub joint_step: bool,
-    #[serde(default, skip_serializing_if = "is_false")]
-    pub walked_lm: bool,
-    #[serde(default, skip_serializing_if = "is_false")]
-    pub deferred_recalibration: bool,
-    #[serde(default, skip_serializing_if = "is_false")]
-    pub rivals_at_end: bool,
-    #[serde(default, skip_serializing_if = "is_false")]
-    pub look_alikes_at_end: bool,
-}
-
-fn is_false(b: &bool) -> bool {
-    !*b
-}
-
-fn is_zero(n: &usize) -> bool {
-    *n == 0
+    /// The selection of every case (the diagnosis' default in the standard run). Flattened
+    /// into the points file's signature, where only its rules that are on appear
+    /// ([`SelectOptions`]'s serialisation): a run with other rules is another benchmark and
+    /// cannot resume this one's file, and a run with all of them off
+    /// (`SelectOptions::plain`) has the signature of the files written before they were the
+    /// default.
+    #[serde(flatten)]
+    pub select: SelectOptions,
 }
 
 impl BenchmarkOptions {
-    /// The selection's options of every case.
-    fn select_options(&self) -> SelectOptions {
-        SelectOptions {
-            exchange_rounds: self.exchange_rounds,
-            look_ahead: self.look_ahead,
-            joint_step: self.joint_step,
-            walked_lm: self.walked_lm,
-            deferred_recalibration: self.deferred_recalibration,
-            rivals_at_end: self.rivals_at_end,
-            look_alikes_at_end: self.look_alikes_at_end,
-            ..SelectOptions::default()
-        }
-    }
-
-    /// Run every case with these rules of the selection (its thresholds stay the default).
-    pub fn set_selection(&mut self, s: &SelectOptions) {
-        self.exchange_rounds = s.exchange_rounds;
-        self.look_ahead = s.look_ahead;
-        self.joint_step = s.joint_step;
-        self.walked_lm = s.walked_lm;
-        self.deferred_recalibration = s.deferred_recalibration;
-        self.rivals_at_end = s.rivals_at_end;
-        self.look_alikes_at_end = s.look_alikes_at_end;
-    }
-
     /// The benchmark for a design (the bundled Mugatu's parameter errors).
     pub fn standard(design: &str) -> BenchmarkOptions {
         let p = |v: &[(&str, f64)]| -> Vec<(String, f64)> {
             v.iter().map(|(k, x)| (k.to_string(), *x)).collect()
         };
-        let mut o = BenchmarkOptions {
+        BenchmarkOptions {
             design: design.to_string(),
             noise_levels: vec![0.01, 0.03, 0.05, 0.10],
             null_cases: 300,
@@ -200,16 +155,8 @@ impl BenchmarkOptions {
                 p(&[("mass.leg_inertia_box_over_l[1]", 0.26)]),
             ],
             effects: Vec::new(),
-            exchange_rounds: 0,
-            look_ahead: false,
-            joint_step: false,
-            walked_lm: false,
-            deferred_recalibration: false,
-            rivals_at_end: false,
-            look_alikes_at_end: false,
-        };
-        o.set_selection(&SelectOptions::default());
-        o
+            select: SelectOptions::default(),
+        }
     }
 }
 
@@ -536,7 +483,7 @@ pub fn plan(
     Ok(Plan {
         cases,
         thresholds: thr.table,
-        select: opts.select_options(),
+        select: opts.select.clone(),
         suites,
         drake,
     })

@@ -741,29 +741,30 @@ impl<'a> FitContext<'a> {
             return Ok(None);
         }
         let r0 = self.residuals(&fit.active, &fit.point, sims);
-        let mut jac = nalgebra::DMatrix::<f64>::zeros(r0.len(), others.len());
-        for (j, &o) in others.iter().enumerate() {
-            let knob = &self.knobs.list[o];
-            let Some(x) = fit.point[o] else {
-                return Ok(None);
-            };
-            let u = knob.to_unit(x);
-            let h = if u + LM_STEP <= 1.0 {
-                LM_STEP
-            } else {
-                -LM_STEP
-            };
-            let mut p = fit.point.clone();
-            p[o] = Some(knob.from_unit(u + h));
-            let r = self.residuals(&fit.active, &p, &self.walks(&p)?);
-            if r.len() != r0.len() {
-                return Ok(None);
-            }
-            for (row, (a, b)) in r.iter().zip(&r0).enumerate() {
-                jac[(row, j)] = (a - b) / h;
-            }
-        }
-        Ok(jac.iter().all(|v| v.is_finite()).then_some(jac))
+        let Some(s0) = others
+            .iter()
+            .map(|&o| fit.point[o].map(|x| self.knobs.list[o].to_unit(x)))
+            .collect::<Option<Vec<f64>>>()
+        else {
+            return Ok(None);
+        };
+        // Only the moved knob is set from its unit coordinate: the others keep the fit's
+        // values bit for bit (a round trip through the unit box need not).
+        let jac = super::solver::forward_jacobian(
+            |u: &[f64]| {
+                let mut p = fit.point.clone();
+                for ((&o, &v), &v0) in others.iter().zip(u).zip(&s0) {
+                    if v != v0 {
+                        p[o] = Some(self.knobs.list[o].from_unit(v));
+                    }
+                }
+                Ok::<_, GapError>(self.residuals(&fit.active, &p, &self.walks(&p)?))
+            },
+            &s0,
+            &r0,
+            LM_STEP,
+        )?;
+        Ok(jac.filter(|j| j.iter().all(|v| v.is_finite())))
     }
 
     /// The real χ² (with prior) of `fit` with knob `knob` at coordinate `x`: the smallest of

@@ -38,15 +38,22 @@ use super::knob::{KnobKind, Point};
 use super::surrogate::Correction;
 use crate::regression::dist::{chi2_upper_p, normal_quantile};
 
-#[derive(Clone, Debug)]
+/// The selection's thresholds and rules. Serialised (a benchmark's signature, flattened into
+/// `BenchmarkOptions`), only the rules that are on appear: a run with other rules is another
+/// benchmark, and a rule off writes what the files written before it existed have.
+#[derive(Clone, Debug, Serialize)]
 pub struct SelectOptions {
     /// Family-wise false-alarm rate of each step's tests.
+    #[serde(skip)]
     pub alpha: f64,
     /// Smallest shrink of the held-out gap a step must make (unless it reaches noise).
+    #[serde(skip)]
     pub material_shrink: f64,
+    #[serde(skip)]
     pub max_steps: usize,
     /// Recalibrate every uncertain parameter even when no effect needs the test (for the
     /// report's table); otherwise only when an effect is tested.
+    #[serde(skip)]
     pub always_recalibrate: bool,
     /// Rounds of the exchange step after the backward pass (`Selector::swap`). 1 by default
     /// (with `look_ahead`, `deferred_recalibration` and `rivals_at_end`, since 2026-11-28):
@@ -54,7 +61,15 @@ pub struct SelectOptions {
     /// session) they named nothing on 700 nulls, lost no right name and removed every
     /// spurious knob of the noisy pairs. Alone, on 165 cases (2026-11-27), it once exchanged
     /// Coulomb friction for its look-alike, damping.
+    #[serde(skip_serializing_if = "is_zero")]
     pub exchange_rounds: usize,
+    /// The look-ahead check (`Selector::look_ahead`): a named knob that a model of the
+    /// answer's size, or one size up, without it fits better than any with it is not
+    /// named. It only takes names away. With the exchange step, on the benchmark's 42 pair
+    /// cases (2026-11-27): no knob outside a pair named on noisy trials (0 / 21, was 2),
+    /// both named as with the exchange alone, 2.2× the walks. On by default.
+    #[serde(skip_serializing_if = "is_false")]
+    pub look_ahead: bool,
     /// Experimental: when no single knob passes and the model is beyond noise, fit pairs of
     /// knobs together (`Selector::joint`). Off by default. Tried on four expected-trial
     /// cases (2026-11-25) it fired once, after a look-alike first step, and its pair led to
@@ -65,13 +80,8 @@ pub struct SelectOptions {
     /// Coulomb friction its pair was viscous damping + backlash (Coulomb's look-alike,
     /// named, with a wrong parameter after it): it weighs only the three pairs it walks,
     /// so a look-alike pair that the surrogate ranks first wins.
+    #[serde(skip_serializing_if = "is_false")]
     pub joint_step: bool,
-    /// The look-ahead check (`Selector::look_ahead`): a named knob that a model of the
-    /// answer's size, or one size up, without it fits better than any with it is not
-    /// named. It only takes names away. With the exchange step, on the benchmark's 42 pair
-    /// cases (2026-11-27): no knob outside a pair named on noisy trials (0 / 21, was 2),
-    /// both named as with the exchange alone, 2.2× the walks. On by default.
-    pub look_ahead: bool,
     /// Levenberg–Marquardt on walks (`FitContext::levenberg_marquardt`) for the two fits
     /// the call rule weighs against each other: the recalibration of every uncertain
     /// parameter, and an effect (or pair) with it. Their dozen knobs interact where the
@@ -80,6 +90,7 @@ pub struct SelectOptions {
     /// Off: measured on every noisy pair (reports/gap-benchmark.md, fifth session) it named
     /// both causes of 2 more pairs and of 4 fewer (the recalibration gains more than the
     /// effect does), at 1.9× the walks.
+    #[serde(skip_serializing_if = "is_false")]
     pub walked_lm: bool,
     /// An effect that passes every rule of its step but the test against the
     /// recalibration is taken anyway when no knob passes them all, and tested against the
@@ -91,6 +102,7 @@ pub struct SelectOptions {
     /// sixth session): both causes named in 14/21 (default 11/21, no pair lost), no new
     /// wrong name there or on 40 parameter-error, compound and Drake cases; 1.3× the walks
     /// on the pairs.
+    #[serde(skip_serializing_if = "is_false")]
     pub deferred_recalibration: bool,
     /// The look-alikes a step could not tell its knob from are compared again
     /// in the final model (`Selector::rivals_at_end`): the knob exchanged for each, walked.
@@ -98,6 +110,7 @@ pub struct SelectOptions {
     /// identification distance by as much as its misfit (φ ≈ 20 on the benchmark's pairs),
     /// so most near candidates are "not separable"; with both causes in, φ ≈ 1. Measured
     /// with `deferred_recalibration` (above). On by default.
+    #[serde(skip_serializing_if = "is_false")]
     pub rivals_at_end: bool,
     /// Experimental: every named knob's look-alikes found again in the final model, among
     /// all knobs outside it (`Selector::look_alikes_at_end`), by the step's own rule: the
@@ -108,7 +121,16 @@ pub struct SelectOptions {
     /// missing, with Coulomb friction worse by more than the distance at that step but
     /// alike once the motor line is in — makes the knob ambiguous; flags are cleared only
     /// when no named knob has a look-alike in the final model.
+    #[serde(skip_serializing_if = "is_false")]
     pub look_alikes_at_end: bool,
+}
+
+fn is_false(b: &bool) -> bool {
+    !*b
+}
+
+fn is_zero(n: &usize) -> bool {
+    *n == 0
 }
 
 impl Default for SelectOptions {

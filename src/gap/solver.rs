@@ -182,6 +182,31 @@ pub fn gauss_newton_step(jac: &nalgebra::DMatrix<f64>, r: &[f64], lambda: f64) -
     Some(delta.iter().copied().collect())
 }
 
+/// The forward-difference Jacobian of `residuals` at `s` in the unit box, whose residuals are
+/// `r0`: one evaluation per coordinate, moved by `step` (backward where forward would leave
+/// the box). `None` where a moved point's residuals are not as many as `r0`.
+pub fn forward_jacobian<E>(
+    mut residuals: impl FnMut(&[f64]) -> Result<Vec<f64>, E>,
+    s: &[f64],
+    r0: &[f64],
+    step: f64,
+) -> Result<Option<nalgebra::DMatrix<f64>>, E> {
+    let mut jac = nalgebra::DMatrix::<f64>::zeros(r0.len(), s.len());
+    for i in 0..s.len() {
+        let h = if s[i] + step <= 1.0 { step } else { -step };
+        let mut u = s.to_vec();
+        u[i] += h;
+        let ri = residuals(&u)?;
+        if ri.len() != r0.len() {
+            return Ok(None);
+        }
+        for (row, (a, b)) in ri.iter().zip(r0).enumerate() {
+            jac[(row, i)] = (a - b) / h;
+        }
+    }
+    Ok(Some(jac))
+}
+
 /// Levenberg–Marquardt on residuals r(s) over the unit box (cost Σr²), from `start` whose
 /// residuals are `r0`: a forward-difference Jacobian, the damped normal equations
 /// (JᵀJ + λ·diag JᵀJ) δ = −Jᵀr solved by Cholesky, the step clipped to the box and taken
@@ -197,27 +222,15 @@ pub fn levenberg_marquardt<E>(
     r0: Vec<f64>,
     set: &LmSettings,
 ) -> Result<(Vec<f64>, Vec<f64>), E> {
-    let k = start.len();
     let cost = |r: &[f64]| r.iter().map(|v| v * v).sum::<f64>();
     let mut s: Vec<f64> = start.iter().map(|v| v.clamp(0.0, 1.0)).collect();
     let mut r = r0;
     let mut f = cost(&r);
     let mut lambda = set.lambda0;
     for _ in 0..set.iters {
-        let mut jac = nalgebra::DMatrix::<f64>::zeros(r.len(), k);
-        for i in 0..k {
-            let h = if s[i] + set.step <= 1.0 {
-                set.step
-            } else {
-                -set.step
-            };
-            let mut u = s.clone();
-            u[i] += h;
-            let ri = residuals(&u)?;
-            for (row, (a, b)) in ri.iter().zip(&r).enumerate() {
-                jac[(row, i)] = (a - b) / h;
-            }
-        }
+        let Some(jac) = forward_jacobian(&mut residuals, &s, &r, set.step)? else {
+            break;
+        };
         let mut accepted = false;
         for _ in 0..set.tries {
             let Some(delta) = gauss_newton_step(&jac, &r, lambda) else {
@@ -279,6 +292,41 @@ mod tests {
         };
         let r0 = res(start).expect("r0");
         levenberg_marquardt(res, start, r0, &set).expect("lm")
+    }
+
+    /// r(s) = (2·s₀ + s₁, 3·s₁) has the Jacobian [[2, 1], [0, 3]] everywhere (by hand), and
+    /// forward differences are exact on a linear map: at s = (0.5, 1) the second coordinate
+    /// is moved backward (the map refuses points outside the box) and must give the same
+    /// column. Residuals that change in number have no Jacobian.
+    #[test]
+    fn forward_jacobian_of_a_linear_map_is_its_matrix() {
+        let lin = |s: &[f64]| {
+            if s.iter().any(|v| !(0.0..=1.0).contains(v)) {
+                return Err(format!("{s:?} is outside the box"));
+            }
+            Ok(vec![2.0 * s[0] + s[1], 3.0 * s[1]])
+        };
+        let s = [0.5, 1.0];
+        let r0 = lin(&s).expect("residuals");
+        let jac = forward_jacobian(lin, &s, &r0, 1.0 / 64.0)
+            .expect("residuals")
+            .expect("same count");
+        let want = [[2.0, 1.0], [0.0, 3.0]];
+        for (i, row) in want.iter().enumerate() {
+            for (j, w) in row.iter().enumerate() {
+                assert!(
+                    (jac[(i, j)] - w).abs() < 1e-9,
+                    "({i}, {j}): {}",
+                    jac[(i, j)]
+                );
+            }
+        }
+        let ragged = |s: &[f64]| Ok::<_, String>(vec![s[0]; if s[0] > 0.5 { 3 } else { 2 }]);
+        assert!(
+            forward_jacobian(ragged, &s, &r0, 1.0 / 64.0)
+                .expect("residuals")
+                .is_none()
+        );
     }
 
     /// J = [[1, 0], [0, 2], [1, 1]], r = (1, 2, 3): JᵀJ = [[2, 1], [1, 5]], Jᵀr = (4, 7), so

@@ -1136,19 +1136,19 @@ fn a_benchmark_with_other_selection_rules_is_another_benchmark() {
         header.ends_with(&format!("{}]", tail(&standard))),
         "{header}"
     );
-    opts.set_selection(&SelectOptions::plain());
+    opts.select = SelectOptions::plain();
     let plain = serde_json::to_string(&opts).expect("options serialise");
     assert!(plain.ends_with("\"effects\":[]}"), "{plain}");
     let plain_file = std::fs::read_to_string(repo().join("reports/gap-benchmark-plain.points.csv"))
         .expect("the plain selection's points file");
     let plain_header = plain_file.lines().next().unwrap_or_default();
     assert!(plain_header.ends_with("\"effects\":[]}]"), "{plain_header}");
-    opts.set_selection(&SelectOptions {
+    opts.select = SelectOptions {
         joint_step: true,
         walked_lm: true,
         look_alikes_at_end: true,
         ..SelectOptions::default()
-    });
+    };
     let with = serde_json::to_string(&opts).expect("options serialise");
     assert!(with.contains("\"joint_step\":true"), "{with}");
     assert!(with.contains("\"walked_lm\":true"), "{with}");
