@@ -142,6 +142,7 @@ pub fn case_design(root: &Path, case: &Case) -> Result<Design, CrosscheckError> 
     // box): the design's [[uncertain]] ranges describe the walker, not these bodies, and
     // an override outside them is the case, not an error.
     table.remove("uncertain");
+    table.remove("audit");
     let text = toml::to_string(&table).map_err(|e| CrosscheckError::Invalid {
         path: path.clone(),
         message: e.to_string(),

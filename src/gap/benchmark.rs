@@ -92,6 +92,10 @@ pub struct BenchmarkOptions {
     /// default.
     #[serde(flatten)]
     pub select: SelectOptions,
+    /// The undeclared-parameter audit on every case ([`super::audit`]); written into the
+    /// signature only when on.
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub audit_undeclared: bool,
 }
 
 impl BenchmarkOptions {
@@ -156,6 +160,7 @@ impl BenchmarkOptions {
             ],
             effects: Vec::new(),
             select: SelectOptions::default(),
+            audit_undeclared: false,
         }
     }
 }
@@ -402,6 +407,7 @@ pub struct Plan {
     pub thresholds: BTreeMap<String, Vec<(String, Option<f64>)>>,
     /// The selection's options of every case (the rules the run asks for).
     select: SelectOptions,
+    audit_undeclared: bool,
     suites: Vec<Suite>,
     drake: BTreeMap<String, (TrialSet, Vec<SimMetrics>)>,
 }
@@ -484,6 +490,7 @@ pub fn plan(
         cases,
         thresholds: thr.table,
         select: opts.select.clone(),
+        audit_undeclared: opts.audit_undeclared,
         suites,
         drake,
     })
@@ -921,6 +928,7 @@ fn run_case(
         explanations: false,
         identifiability: false,
         select: plan.select.clone(),
+        audit_undeclared: plan.audit_undeclared,
         ..DiagnoseOptions::default()
     };
     let walks0 = suite.cache.walks();

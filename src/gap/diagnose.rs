@@ -48,6 +48,10 @@ pub struct DiagnoseOptions {
     /// benchmark's cases skip it: the answer does not depend on it).
     pub explanations: bool,
     pub select: SelectOptions,
+    /// Audit what the answer names against the designs' undeclared numbers
+    /// ([`super::audit`]): a named knob that one of them, in its place, fits as well is not
+    /// named.
+    pub audit_undeclared: bool,
 }
 
 impl Default for DiagnoseOptions {
@@ -61,6 +65,7 @@ impl Default for DiagnoseOptions {
             identifiability: true,
             explanations: true,
             select: SelectOptions::default(),
+            audit_undeclared: false,
         }
     }
 }
@@ -367,6 +372,36 @@ pub fn build_surrogate(
         &super::knob::ModelSetting::nominal(),
         progress,
     )?;
+    let all: Vec<usize> = (0..knobs.len()).collect();
+    let curves = build_curves(
+        conditions,
+        lib,
+        knobs,
+        &all,
+        &nominal,
+        obs,
+        grid_points,
+        cache,
+        progress,
+    )?;
+    Ok(Surrogate { nominal, curves })
+}
+
+/// The curves of the knobs `which` (of `knobs`), in that order: `grid_points` walks over each
+/// knob's range, then midpoints where a segment bends more than the data resolve; `nominal`:
+/// the nominal model's walks (a nominal node inside the range is that walk).
+#[allow(clippy::too_many_arguments)]
+pub fn build_curves(
+    conditions: &[Condition],
+    lib: &EffectLibrary,
+    knobs: &Knobs,
+    which: &[usize],
+    nominal: &[super::simulate::SimMetrics],
+    obs: &[Observation],
+    grid_points: usize,
+    cache: &SimCache,
+    progress: &dyn Observer,
+) -> Result<Vec<Curve>, GapError> {
     let setting_at = |k: usize, x: f64| {
         let mut point = knobs.nominal_point();
         point[k] = Some(x);
@@ -374,30 +409,34 @@ pub fn build_surrogate(
     };
     let mut settings = Vec::new();
     let mut nodes_of = Vec::new();
-    for (k, knob) in knobs.list.iter().enumerate() {
-        let nodes = knob.nodes(grid_points);
+    for &k in which {
+        let nodes = knobs.list[k].nodes(grid_points);
         settings.extend(nodes.iter().map(|x| setting_at(k, *x)));
         nodes_of.push(nodes);
     }
     let sims = cache.get_many(conditions, lib, &settings, progress)?;
     let mut it = sims.into_iter();
     let mut curves = Vec::new();
-    for (knob, nodes) in knobs.list.iter().zip(nodes_of) {
+    for (&k, nodes) in which.iter().zip(nodes_of) {
         let s: Vec<_> = (0..nodes.len()).filter_map(|_| it.next()).collect();
         let mut curve = Curve::new(nodes, s);
         // A nominal inside the range (a parameter's file value, the design's own μ) is a
         // walk already made: the nominal one.
-        if let Some(x) = knob.nominal {
-            curve.insert(x, &nominal);
+        if let Some(x) = knobs.list[k].nominal {
+            curve.insert(x, nominal);
         }
         curves.push(curve);
     }
     for _ in 0..CURVE_ROUNDS {
+        // (position in `which`, coordinate)
         let mut wanted: Vec<(usize, f64)> = Vec::new();
-        for (k, (knob, curve)) in knobs.list.iter().zip(&curves).enumerate() {
+        for (j_knob, (&k, curve)) in which.iter().zip(&curves).enumerate() {
+            let knob = &knobs.list[k];
             let min_gap = (knob.hi - knob.lo) / 64.0;
             for j in 0..curve.x.len().saturating_sub(1) {
-                if curve.x.len() + wanted.iter().filter(|w| w.0 == k).count() >= CURVE_MAX_NODES {
+                if curve.x.len() + wanted.iter().filter(|w| w.0 == j_knob).count()
+                    >= CURVE_MAX_NODES
+                {
                     break;
                 }
                 let (a, b) = (curve.x[j], curve.x[j + 1]);
@@ -424,7 +463,7 @@ pub fn build_surrogate(
                     }
                 });
                 if steep {
-                    wanted.push((k, 0.5 * (a + b)));
+                    wanted.push((j_knob, 0.5 * (a + b)));
                 }
             }
         }
@@ -432,18 +471,21 @@ pub fn build_surrogate(
             break;
         }
         progress.stage("refining the knobs' curves where the gait changes fast");
-        let settings: Vec<_> = wanted.iter().map(|(k, x)| setting_at(*k, *x)).collect();
+        let settings: Vec<_> = wanted
+            .iter()
+            .map(|(j, x)| setting_at(which[*j], *x))
+            .collect();
         let sims = cache.get_many(conditions, lib, &settings, progress)?;
-        for ((k, x), s) in wanted.into_iter().zip(sims) {
-            curves[k].insert(x, &s);
+        for ((j, x), s) in wanted.into_iter().zip(sims) {
+            curves[j].insert(x, &s);
         }
     }
     if std::env::var("GAP_DEBUG").is_ok() {
-        for (k, c) in knobs.list.iter().zip(&curves) {
-            eprintln!("{}: {} nodes", k.label(), c.x.len());
+        for (&k, c) in which.iter().zip(&curves) {
+            eprintln!("{}: {} nodes", knobs.list[k].label(), c.x.len());
         }
     }
-    Ok(Surrogate { nominal, curves })
+    Ok(curves)
 }
 
 /// [`diagnose`] on resolved conditions, sharing walks through `cache`.
@@ -536,10 +578,22 @@ pub fn diagnose_conditions(
     } else {
         (Vec::new(), Vec::new())
     };
+    let mut steps = selection.steps.clone();
+    if opts.audit_undeclared {
+        super::audit::audit_undeclared(
+            &ctx,
+            &designs,
+            &final_fit,
+            &mut steps,
+            opts.alpha,
+            opts.grid_points,
+            &mut notes,
+        )?;
+    }
     let final_fit = &final_fit;
     let answer = answer(
         &ctx,
-        &selection.steps,
+        &steps,
         final_fit,
         nominal_within_noise,
         opts.alpha,
@@ -578,7 +632,7 @@ pub fn diagnose_conditions(
             summary,
             where_,
             answer,
-            chain: selection.steps.clone(),
+            chain: steps,
             explanations,
             calibration,
             single,

@@ -16,7 +16,9 @@
 //! * [`select`]: forward selection with the call rules, the backward pass, and four rules
 //!   that judge the chain again with every cause of it in (on by default: an exchange
 //!   round, the look-ahead check, the deferred recalibration test, look-alikes compared at
-//!   the end); [`diagnose`]: the answer;
+//!   the end); [`audit`]: the answer's named knobs against every number the designs do not
+//!   declare (`--audit-undeclared`: one that fits as well in a knob's place unnames it);
+//!   [`diagnose`]: the answer;
 //!   [`locate`]: where the gap lies; [`identify`]: detection and identification thresholds.
 //! * [`waveform`]: a robot's log (time, hip angle, attitude, torque) reduced to the Fourier
 //!   coefficients of its steady cycle, and their χ² against a simulated cycle;
@@ -31,6 +33,7 @@
 //! [`crate::checkpoint`] (the benchmark's resumable points file) and [`crate::progress`]
 //! (the observer its long runs report to) only.
 
+pub mod audit;
 pub mod benchmark;
 pub mod cache;
 pub mod curve;

@@ -250,7 +250,7 @@ pub fn within_noise(fit: &Fit, n: usize, alpha: f64) -> bool {
 
 /// χ² difference below which two candidates of one step are not separable: the
 /// identification distance (2·z₀.₉)², the χ² a 90 %-sure distinction needs.
-fn separable_margin() -> f64 {
+pub(crate) fn separable_margin() -> f64 {
     let z = 2.0 * normal_quantile(0.9).unwrap_or(1.2816);
     z * z
 }

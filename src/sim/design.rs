@@ -191,7 +191,51 @@ pub struct Design {
     /// the design hash of a study ignore them.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub uncertain: Vec<UncertainSpec>,
+    /// How the gap diagnosis audits the values the file does *not* declare uncertain
+    /// (`survey gap diagnose --audit-undeclared`). Not physics either.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub audit: Option<AuditSpec>,
 }
+
+/// The undeclared-parameter audit of a design: every number of its physical sections
+/// (geometry, mass, contact, control, hardstop, ground) that `[[uncertain]]` does not declare
+/// is a suspect over a default range, except those listed here as known.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, Default)]
+#[serde(deny_unknown_fields)]
+pub struct AuditSpec {
+    /// Values known well enough not to be suspects (measured, commanded, or without effect
+    /// on the walks), each with why. A path covers what lies under it: `hardstop`, or
+    /// `geometry.foot_semi_axes_m` for all three axes.
+    #[serde(default)]
+    pub fixed: Vec<FixedSpec>,
+    /// An undeclared value may be off by up to this factor either way (log scale; default
+    /// [`AUDIT_FACTOR`]).
+    #[serde(default)]
+    pub factor: Option<f64>,
+    /// An undeclared offset whose file value is 0 (a field in leg lengths, `…_over_l`) may be
+    /// off by up to ± this many leg lengths (default [`AUDIT_OFFSET_OVER_L`]).
+    #[serde(default)]
+    pub offset_over_l: Option<f64>,
+}
+
+/// A value the audit leaves alone, and why.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct FixedSpec {
+    pub path: String,
+    pub why: String,
+}
+
+/// Default factor of the audit's range: an undeclared guess taken to be right within ×/÷ 2.
+pub const AUDIT_FACTOR: f64 = 2.0;
+/// Default half-range of an undeclared zero offset: 3 % of the leg length (5 mm at the
+/// Mugatu's 1×), the scale of a build tolerance.
+pub const AUDIT_OFFSET_OVER_L: f64 = 0.03;
+/// The sections whose numbers describe the robot and its floor (the others set the start,
+/// the integrator and the walk criteria: not suspects of a gap).
+const AUDITED_SECTIONS: [&str; 6] = [
+    "geometry", "mass", "contact", "control", "hardstop", "ground",
+];
 
 /// A number of a design file that is not known: where it is, how far it may be off, and why.
 /// Give a `range` (plausible values, a uniform prior), an `sd` or `relative_sd` (a Gaussian
@@ -243,6 +287,39 @@ fn path_steps(path: &str) -> Option<Vec<(&str, Option<usize>)>> {
             _ => None,
         })
         .collect()
+}
+
+/// Every float of the audited sections of a design's TOML tree, by dotted path (arrays
+/// indexed: `geometry.foot_semi_axes_m[0]`), in the tree's order.
+fn leaf_paths(tree: &toml::Value) -> Vec<(String, f64)> {
+    let mut out = Vec::new();
+    for section in AUDITED_SECTIONS {
+        let Some(t) = tree.get(section).and_then(|v| v.as_table()) else {
+            continue;
+        };
+        for (key, v) in t {
+            match v {
+                toml::Value::Float(x) => out.push((format!("{section}.{key}"), *x)),
+                toml::Value::Array(a) => {
+                    for (i, x) in a.iter().enumerate() {
+                        if let Some(x) = x.as_float() {
+                            out.push((format!("{section}.{key}[{i}]"), x));
+                        }
+                    }
+                }
+                _ => {}
+            }
+        }
+    }
+    out
+}
+
+/// A `fixed` path covers a leaf: the same path, or a section or array above it.
+fn covers(fixed: &str, leaf: &(String, f64)) -> bool {
+    let p = leaf.0.as_str();
+    p == fixed
+        || p.strip_prefix(fixed)
+            .is_some_and(|rest| rest.starts_with('.') || rest.starts_with('['))
 }
 
 /// The number at `path` of a TOML tree, mutably.
@@ -798,7 +875,118 @@ impl Design {
             }
             self.resolve_uncertain(i, u, origin)?;
         }
+        self.check_audit(origin)
+    }
+
+    fn check_audit(&self, origin: &str) -> Result<(), SimError> {
+        let Some(a) = &self.audit else {
+            return Ok(());
+        };
+        let bad = |field: String, value: String, reason: &str| SimError::InvalidValue {
+            origin: origin.to_string(),
+            field,
+            value,
+            reason: reason.to_string(),
+        };
+        if let Some(f) = a.factor
+            && !(f > 1.0 && f.is_finite())
+        {
+            return Err(bad(
+                "audit.factor".into(),
+                f.to_string(),
+                "must be finite and > 1",
+            ));
+        }
+        if let Some(o) = a.offset_over_l
+            && !(o > 0.0 && o.is_finite())
+        {
+            return Err(bad(
+                "audit.offset_over_l".into(),
+                o.to_string(),
+                "must be finite and > 0",
+            ));
+        }
+        let tree = self.to_tree()?;
+        for (i, f) in a.fixed.iter().enumerate() {
+            if f.why.trim().is_empty() {
+                return Err(bad(
+                    format!("audit.fixed[{i}].why"),
+                    "\"\"".into(),
+                    "say why the value is known (its tag and reasoning)",
+                ));
+            }
+            if !leaf_paths(&tree).iter().any(|p| covers(&f.path, p)) {
+                return Err(bad(
+                    format!("audit.fixed[{i}].path"),
+                    f.path.clone(),
+                    "names no number of the design's geometry, mass, contact, control, hardstop or ground",
+                ));
+            }
+        }
         Ok(())
+    }
+
+    /// The numbers the design does not declare uncertain, as the undeclared-parameter audit
+    /// weighs them: every number of the physical sections that is neither declared
+    /// (`[[uncertain]]`) nor listed known (`[audit] fixed`), over ×/÷ the audit's factor
+    /// around the file's value (log scale), or ± its offset for a zero `…_over_l` offset.
+    /// A range end that is not a valid design is pulled halfway toward the file's value
+    /// (up to 4 times; then the file's value is that end). Zero values of other units and
+    /// integers are left out (no scale to take).
+    pub fn undeclared_params(&self) -> Result<Vec<UncertainParam>, SimError> {
+        let spec = self.audit.clone().unwrap_or_default();
+        let factor = spec.factor.unwrap_or(AUDIT_FACTOR);
+        let offset = spec.offset_over_l.unwrap_or(AUDIT_OFFSET_OVER_L);
+        let tree = self.to_tree()?;
+        let mut out = Vec::new();
+        for (path, nominal) in leaf_paths(&tree) {
+            // The 1× leg length is the size every other value scales from, and the trials
+            // state each condition's own: not a suspect.
+            if path == "geometry.leg_length_m"
+                || self.uncertain.iter().any(|u| u.path == path)
+                || spec
+                    .fixed
+                    .iter()
+                    .any(|f| covers(&f.path, &(path.clone(), nominal)))
+            {
+                continue;
+            }
+            let (lo, hi, log) = if nominal > 0.0 {
+                (nominal / factor, nominal * factor, true)
+            } else if nominal < 0.0 {
+                (nominal * factor, nominal / factor, false)
+            } else if path.ends_with("_over_l") {
+                (-offset, offset, false)
+            } else {
+                continue;
+            };
+            let valid_end = |end: f64| {
+                let mut v = end;
+                for _ in 0..5 {
+                    if self.with_value(&path, v).is_ok() {
+                        return v;
+                    }
+                    v = 0.5 * (v + nominal);
+                }
+                nominal
+            };
+            let (lo, hi) = (valid_end(lo), valid_end(hi));
+            if lo >= hi {
+                continue;
+            }
+            out.push(UncertainParam {
+                why: format!(
+                    "undeclared: not in the design's [[uncertain]]; audited over [{lo:.4}, {hi:.4}]"
+                ),
+                path,
+                nominal,
+                lo,
+                hi,
+                prior_sd: None,
+                log,
+            });
+        }
+        Ok(out)
     }
 
     pub fn leg_length_m(&self) -> f64 {

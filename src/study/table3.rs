@@ -180,9 +180,11 @@ impl Table3Spec {
 /// The first 16 hex digits of the SHA-256 of a design's full parameter set (JSON): a
 /// points file names the exact designs it was made with.
 pub fn design_hash(d: &Design) -> String {
-    // The uncertain-parameter declarations are not physics: the same walks with or without.
+    // The uncertain-parameter declarations and the audit's are not physics: the same walks
+    // with or without.
     let physics = Design {
         uncertain: Vec::new(),
+        audit: None,
         ..d.clone()
     };
     let json = serde_json::to_string(&physics).unwrap_or_default();
