@@ -231,7 +231,9 @@ pub struct SelectionArgs {
     /// [[uncertain]] (×/÷ 2 around the file's value, or the design's [audit] table): a
     /// named knob that an undeclared number, in its place, fits as well (within the
     /// identification distance) is not named — the answer says "not told apart from the
-    /// undeclared …". About 1,000–2,000 more walks, and only when something is named.
+    /// undeclared …". Runs only when something is named: 1.2–2.2× the walks; on the
+    /// benchmark it unnamed 2 stand-ins for undeclared errors and 5 right names
+    /// (μ beside the stiction speed, the servo gain beside its torque limit).
     #[arg(long)]
     pub audit_undeclared: bool,
 }

@@ -9,15 +9,20 @@
 //! foot offset, μ for a 3× stiction speed). The audit asks the question the user would: for
 //! every named knob, does some undeclared number of the design, in its place, explain the
 //! trials as well? Each undeclared number is walked over its range like a knob
-//! ([`Design::undeclared_params`]: ×/÷ 2 by default, the design's `[audit]` table narrows
-//! it) and each named knob exchanged for each of them is fitted with walks (the surrogate
-//! misjudges these exchanges: each number's curve is walked once over a wide range, and
-//! a number the design left at a symmetric 0 can change the gait at a hair's offset). The
-//! rule is the step's own look-alike rule: the exchange
+//! ([`Design::undeclared_params`]: ×/÷ 2 by default; the design's `[audit]` table lists the
+//! numbers known and may set the factor) and each named knob exchanged for each of them is
+//! fitted with walks (the surrogate misjudges these exchanges: each number's curve is
+//! walked once over a wide range, and a number the design left at a symmetric 0 can change
+//! the gait at a hair's offset). The rule is the step's own look-alike rule: the exchange
 //! fits within the identification distance (2·z₀.₉)²·φ of the answer and its number is
 //! significant against the answer without the knob. A named knob with such a look-alike is
 //! not named: the answer lists it with the undeclared number as "not told apart", and the
 //! note says to declare the number if it is a suspect.
+//!
+//! Measured on the benchmark (reports/gap-benchmark.md, tenth session): the look-alikes it
+//! finds are real ones of the model in both directions — it unnamed 2 stand-ins and 5 right
+//! names (μ beside the stiction speed, the servo gain beside its torque limit) at 1.67× the
+//! walks — so it is off by default (`DiagnoseOptions::audit_undeclared`).
 //!
 //! It only ever takes names away, never adds one (an undeclared number is not a candidate:
 //! declaring it is the user's call, with a range the user can defend).
@@ -208,9 +213,10 @@ pub fn audit_undeclared(
     }
     // An answer of several knobs against each undeclared number alone in place of all of
     // them: one number that fits within the identification distance of the whole answer
-    // (with fewer knobs) makes every named knob a possible stand-in (a 3× stiction speed
-    // read as μ low and the contact damping off: each exchange alone keeps the other
-    // stand-in, and fits worse).
+    // (with fewer knobs) makes every named knob a possible stand-in. The kind it is for: the
+    // benchmark's 3× stiction speed read as μ low and the contact damping off, where each
+    // exchange alone keeps the other stand-in and fits worse (that truth lies outside the
+    // default ×/÷ 2, so there it could not be caught).
     if current.active.len() >= 2 {
         let nominal = actx.nominal()?;
         for &r in &audited {
