@@ -63,21 +63,7 @@ pub fn undeclared_knobs(ctx: &FitContext<'_>, designs: &[&Design]) -> Result<Vec
             {
                 continue;
             }
-            let coord = |v: f64| if u.log { v.ln() } else { v };
-            out.push(Knob {
-                kind: KnobKind::Parameter,
-                design: d.name.clone(),
-                name: u.path.clone(),
-                log: u.log,
-                lo: coord(u.lo),
-                hi: coord(u.hi),
-                nominal: Some(coord(u.nominal)),
-                off_value: None,
-                prior: None,
-                si_per_value: 1.0,
-                unit: String::new(),
-                why: u.why.clone(),
-            });
+            out.push(Knob::parameter(&d.name, &u));
         }
     }
     Ok(out)
@@ -152,12 +138,11 @@ pub fn audit_undeclared(
         surrogate: &surrogate,
         ..*ctx
     };
-    let widen = |f: &Fit| {
-        let mut f = f.clone();
-        f.point.resize(knobs.len(), None);
-        f
-    };
-    let current = widen(current);
+    // The answer as a point of the wider knob list (the undeclared numbers at their values).
+    let mut current = current.clone();
+    current.point.resize(knobs.len(), None);
+    // What a look-alike of a sole knob, and each number alone, must be significant against.
+    let nominal = actx.nominal()?;
     let phi = dispersion(current.chi2_data, n, current.k());
     let margin = separable_margin() * if phi.is_finite() { phi } else { 1.0 };
     let alpha = alpha / (audited.len() + 1) as f64;
@@ -169,7 +154,7 @@ pub fn audit_undeclared(
         without_start.point[c] = None;
         // What the look-alike must be significant against: the answer without `c`, walked.
         let without = if rest.is_empty() {
-            actx.nominal()?
+            nominal.clone()
         } else {
             actx.fit_walked(
                 &rest,
@@ -218,7 +203,6 @@ pub fn audit_undeclared(
     // exchange alone keeps the other stand-in and fits worse (that truth lies outside the
     // default ×/÷ 2, so there it could not be caught).
     if current.active.len() >= 2 {
-        let nominal = actx.nominal()?;
         for &r in &audited {
             let label = knobs.list[r].label();
             actx.progress.stage(&format!(

@@ -51,6 +51,26 @@ pub struct Knob {
 }
 
 impl Knob {
+    /// The knob of a design's parameter (declared `[[uncertain]]`, or an undeclared number
+    /// the audit weighs): its range and prior in the coordinate its scale asks for.
+    pub fn parameter(design: &str, u: &crate::sim::design::UncertainParam) -> Knob {
+        let coord = |v: f64| if u.log { v.ln() } else { v };
+        Knob {
+            kind: KnobKind::Parameter,
+            design: design.to_string(),
+            name: u.path.clone(),
+            log: u.log,
+            lo: coord(u.lo),
+            hi: coord(u.hi),
+            nominal: Some(coord(u.nominal)),
+            off_value: None,
+            prior: u.prior_sd.map(|sd| (u.nominal, sd)),
+            si_per_value: 1.0,
+            unit: String::new(),
+            why: u.why.clone(),
+        }
+    }
+
     /// A readable name: the effect's, or `design:path` for a parameter.
     pub fn label(&self) -> String {
         match self.kind {
@@ -219,21 +239,7 @@ impl Knobs {
         if calibrate {
             for d in designs {
                 for u in d.uncertain_params()? {
-                    let coord = |v: f64| if u.log { v.ln() } else { v };
-                    list.push(Knob {
-                        kind: KnobKind::Parameter,
-                        design: d.name.clone(),
-                        name: u.path.clone(),
-                        log: u.log,
-                        lo: coord(u.lo),
-                        hi: coord(u.hi),
-                        nominal: Some(coord(u.nominal)),
-                        off_value: None,
-                        prior: u.prior_sd.map(|sd| (u.nominal, sd)),
-                        si_per_value: 1.0,
-                        unit: String::new(),
-                        why: u.why.clone(),
-                    });
+                    list.push(Knob::parameter(&d.name, &u));
                 }
             }
         }

@@ -888,23 +888,12 @@ impl Design {
             value,
             reason: reason.to_string(),
         };
-        if let Some(f) = a.factor
-            && !(f > 1.0 && f.is_finite())
-        {
-            return Err(bad(
-                "audit.factor".into(),
-                f.to_string(),
-                "must be finite and > 1",
-            ));
+        let ck = FieldCheck { origin };
+        if let Some(f) = a.factor {
+            ck.check("audit.factor", f, f > 1.0, "must be finite and > 1")?;
         }
-        if let Some(o) = a.offset_over_l
-            && !(o > 0.0 && o.is_finite())
-        {
-            return Err(bad(
-                "audit.offset_over_l".into(),
-                o.to_string(),
-                "must be finite and > 0",
-            ));
+        if let Some(o) = a.offset_over_l {
+            ck.check("audit.offset_over_l", o, o > 0.0, "must be finite and > 0")?;
         }
         let tree = self.to_tree()?;
         for (i, f) in a.fixed.iter().enumerate() {

@@ -124,6 +124,21 @@ fn names(d: &Diagnosis) -> (Vec<String>, Vec<String>) {
     )
 }
 
+/// Each of `cases` (a table appended to the design text `body`, the field the error must
+/// name, why) is refused with an error naming the file, the field and why.
+fn assert_rejected(body: &str, cases: &[(&str, &str, &str)]) {
+    for (entry, field, why) in cases {
+        let text = format!("{body}\n{entry}");
+        let e = Design::from_toml_str(&text, "m.toml")
+            .expect_err(entry)
+            .to_string();
+        assert!(
+            e.contains("m.toml") && e.contains(field) && e.contains(why),
+            "{e}"
+        );
+    }
+}
+
 #[test]
 fn uncertain_declarations_are_checked_and_name_the_entry() {
     let base = std::fs::read_to_string(repo().join("dataset/walkers/mugatu.toml")).expect("read");
@@ -162,16 +177,7 @@ fn uncertain_declarations_are_checked_and_name_the_entry() {
             "has no element 3",
         ),
     ];
-    for (entry, field, why) in cases {
-        let text = format!("{body}\n{entry}");
-        let e = Design::from_toml_str(&text, "m.toml")
-            .expect_err(entry)
-            .to_string();
-        assert!(
-            e.contains("m.toml") && e.contains(field) && e.contains(why),
-            "{e}"
-        );
-    }
+    assert_rejected(body, &cases);
     // A declared value moves only its own number; the range is checked in field units.
     let d = Design::builtin("mugatu").expect("mugatu");
     let moved = d
@@ -1322,16 +1328,7 @@ fn audit_tables_are_checked_and_name_the_field() {
             "> 0",
         ),
     ];
-    for (entry, field, why) in cases {
-        let text = format!("{body}\n{entry}");
-        let e = Design::from_toml_str(&text, "m.toml")
-            .expect_err(entry)
-            .to_string();
-        assert!(
-            e.contains("m.toml") && e.contains(field) && e.contains(why),
-            "{e}"
-        );
-    }
+    assert_rejected(body, &cases);
     // A section covers its numbers; the factor and offset set the ranges.
     let text = format!(
         "{body}\n[audit]\nfixed = [{{ path = \"hardstop\", why = \"x\" }}, {{ path = \"contact\", why = \"x\" }}]\nfactor = 1.5\noffset_over_l = 0.01\n"
