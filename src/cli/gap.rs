@@ -422,6 +422,12 @@ points file at once: a re-run resumes, shards merge into what one run writes.")]
 pub struct BenchmarkArgs {
     #[arg(long, default_value = "mugatu")]
     pub design: String,
+    /// The out-of-library cases (nominal-parameter and compound errors) from this TOML
+    /// (format: dataset/benchmarks/README.md). Default: dataset/benchmarks/<design>.toml when
+    /// it exists, else cases derived from the design (each declared [[uncertain]] value
+    /// half-way to its farther range end; each undeclared number ×1.3 or + 0.015 L)
+    #[arg(long, value_name = "FILE")]
+    pub cases: Option<PathBuf>,
     /// A small run: 20 nulls per noise level, 1 seed, noise 5 % only, no one-robot suite.
     #[arg(long)]
     pub quick: bool,
@@ -818,7 +824,13 @@ fn explore(a: &ExploreArgs) -> anyhow::Result<ExitCode> {
 fn benchmark(a: &BenchmarkArgs) -> anyhow::Result<ExitCode> {
     use robot_survey::checkpoint::Shard;
     let lib = EffectLibrary::bundled()?;
-    let mut opts = gap::benchmark::BenchmarkOptions::standard(&a.design);
+    let mut opts = match &a.cases {
+        Some(file) => gap::benchmark::BenchmarkOptions::with_cases(
+            &a.design,
+            gap::cases::BenchmarkCases::read(file, &a.design)?,
+        ),
+        None => gap::benchmark::BenchmarkOptions::standard(&a.design)?,
+    };
     if a.quick {
         opts.null_cases = 20;
         opts.seeds = 1;

@@ -9,7 +9,9 @@
 //!   (declared uncertain or not, inside or outside their ranges), an unreported slope, a
 //!   drive amplitude off; the single effects again with calibration off; every pair again
 //!   on its expected (noise-free) trials, the ceiling of what any rule could name from such
-//!   trials; a declared parameter error together with each effect (compound cases).
+//!   trials; a declared parameter error together with each effect (compound cases). The
+//!   parameter and compound errors are data ([`super::cases`]: `dataset/benchmarks/<design>.toml`,
+//!   or derived from any other design's declarations).
 //! * `one-robot`: one size, conditions varied by drive frequency, amplitude, payload and
 //!   slope, as a user with one robot would measure.
 //! * `drake`: trials made by Drake on the reference design (`tests/golden/drake/gap/`),
@@ -25,6 +27,7 @@ use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 use super::cache::SimCache;
+use super::cases::BenchmarkCases;
 use super::diagnose::{DiagnoseOptions, diagnose_conditions};
 use super::error::GapError;
 use super::identify::Identifiability;
@@ -99,11 +102,17 @@ pub struct BenchmarkOptions {
 }
 
 impl BenchmarkOptions {
-    /// The benchmark for a design (the bundled Mugatu's parameter errors).
-    pub fn standard(design: &str) -> BenchmarkOptions {
-        let p = |v: &[(&str, f64)]| -> Vec<(String, f64)> {
-            v.iter().map(|(k, x)| (k.to_string(), *x)).collect()
-        };
+    /// The benchmark for a design: its out-of-library cases from
+    /// `dataset/benchmarks/<design>.toml`, or derived from the design ([`BenchmarkCases`]).
+    pub fn standard(design: &str) -> Result<BenchmarkOptions, GapError> {
+        Ok(Self::with_cases(
+            design,
+            BenchmarkCases::for_design(design)?,
+        ))
+    }
+
+    /// The benchmark for a design with these out-of-library cases.
+    pub fn with_cases(design: &str, cases: BenchmarkCases) -> BenchmarkOptions {
         BenchmarkOptions {
             design: design.to_string(),
             noise_levels: vec![0.01, 0.03, 0.05, 0.10],
@@ -112,52 +121,13 @@ impl BenchmarkOptions {
             multiples: vec![1.0, 2.0, 4.0],
             pair_noise: 0.03,
             pair_multiple: 2.0,
-            parameter_errors: vec![
-                p(&[("mass.total_mass_kg", 1.08)]),
-                p(&[("mass.total_mass_kg", 0.72)]),
-                p(&[("mass.leg_inertia_box_over_l[0]", 0.9)]),
-                p(&[("mass.leg_inertia_box_over_l[2]", 1.15)]),
-                p(&[("mass.leg_com_height_over_l", 0.495)]),
-                p(&[("mass.leg_com_height_over_l", 0.405)]),
-                p(&[("mass.leg_com_height_over_l", 0.5175)]),
-                p(&[
-                    ("geometry.foot_semi_axes_m[0]", 0.1056),
-                    ("geometry.foot_semi_axes_m[1]", 0.1056),
-                    ("geometry.foot_semi_axes_m[2]", 0.1056),
-                ]),
-                p(&[
-                    ("geometry.foot_semi_axes_m[0]", 0.1344),
-                    ("geometry.foot_semi_axes_m[1]", 0.1344),
-                    ("geometry.foot_semi_axes_m[2]", 0.1344),
-                ]),
-                p(&[("geometry.hip_half_width_over_l", 0.25)]),
-                p(&[("geometry.hip_half_width_over_l", 0.15)]),
-                p(&[("control.kp_over_mgl", 14.0)]),
-                p(&[("control.kd_over_mgl_sqrt_l_over_g", 2.6)]),
-                p(&[("ground.slope_deg", 1.5)]),
-                p(&[("control.amplitude_deg", 28.75)]),
-                p(&[("mass.leg_com_forward_over_l", 0.02)]),
-                p(&[("contact.hunt_crossley_dissipation_s_per_m", 30.0)]),
-                // Undeclared in the bundled Mugatu, each with a declared or library
-                // look-alike: the lateral edge of the leg's inertia box (+30 %: roll inertia,
-                // like the declared vertical edge), the feet 2 mm forward of the hip (like the
-                // declared forward COM offset), and a stiction speed 3× the file's (the
-                // friction's regularisation: slip at low speed, like rolling resistance).
-                p(&[("mass.leg_inertia_box_over_l[1]", 0.26)]),
-                p(&[("geometry.foot_center_forward_over_l", 0.015)]),
-                p(&[("contact.stiction_speed_mps", 0.003)]),
-            ],
+            parameter_errors: cases.parameter_errors,
             parameter_noise: vec![0.03, 0.05],
             drake_dir: None,
             drake_seeds: 5,
             one_robot_null_cases: 100,
             calibration_off_noise: Some(0.05),
-            // A declared error (the unreported slope: the answer "both") and an undeclared
-            // one (the leg's lateral inertia +30 %: the effect may be named, nothing else).
-            compound_errors: vec![
-                p(&[("ground.slope_deg", 1.5)]),
-                p(&[("mass.leg_inertia_box_over_l[1]", 0.26)]),
-            ],
+            compound_errors: cases.compound_errors,
             effects: Vec::new(),
             select: SelectOptions::default(),
             audit_undeclared: false,

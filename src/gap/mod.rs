@@ -26,7 +26,9 @@
 //!   [`suggest`]: the next trials that best separate the two leading candidates.
 //! * [`synth`]: "real" trials simulated with withheld effects or wrong parameters plus noise
 //!   (and robot logs).
-//! * [`benchmark`]: the diagnosis on cases of known cause, inside and outside its library;
+//! * [`benchmark`]: the diagnosis on cases of known cause, inside and outside its library
+//!   ([`cases`]: its out-of-library errors of a design, as data in `dataset/benchmarks/` or
+//!   derived from the design's declarations);
 //!   [`waveform_bench`]: what the logged cycles buy on the look-alike pairs.
 //!
 //! Depends on [`crate::sim`] (the simulator), [`crate::regression`] (distributions),
@@ -36,6 +38,7 @@
 pub mod audit;
 pub mod benchmark;
 pub mod cache;
+pub mod cases;
 pub mod curve;
 pub mod diagnose;
 pub mod error;

@@ -960,7 +960,7 @@ fn benchmark_scores_count_what_the_rows_say() {
             "",
         ));
     }
-    let opts = BenchmarkOptions::standard("mugatu");
+    let opts = BenchmarkOptions::standard("mugatu").expect("the bundled cases");
     let s = summarize(&rows, &lib, &opts, Default::default());
     let get = |what: &str| {
         s.scores
@@ -1123,7 +1123,7 @@ fn explore_says_cannot_tell_when_its_sample_is_too_sparse() {
 /// any other set of rules cannot be resumed into the committed file.
 #[test]
 fn a_benchmark_with_other_selection_rules_is_another_benchmark() {
-    let mut opts = BenchmarkOptions::standard("mugatu");
+    let mut opts = BenchmarkOptions::standard("mugatu").expect("the bundled cases");
     let standard = serde_json::to_string(&opts).expect("options serialise");
     for on in [
         "\"exchange_rounds\":1",
@@ -1170,7 +1170,7 @@ fn a_benchmark_with_other_selection_rules_is_another_benchmark() {
     assert!(!standard.contains("audit_undeclared"), "{standard}");
     let audited = serde_json::to_string(&BenchmarkOptions {
         audit_undeclared: true,
-        ..BenchmarkOptions::standard("mugatu")
+        ..BenchmarkOptions::standard("mugatu").expect("the bundled cases")
     })
     .expect("options serialise");
     let audit_file = std::fs::read_to_string(repo().join("reports/gap-benchmark-audit.points.csv"))

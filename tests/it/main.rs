@@ -6,6 +6,7 @@ mod common;
 mod diff;
 mod drake_crosscheck;
 mod gap;
+mod gap_cases;
 mod gap_open;
 mod gap_waveform;
 mod live_dataset;
