@@ -56,5 +56,10 @@ prefix "$T/gp.md" gap-published.md; same "$T/gp.svg" gap-published.svg
   --points "$T/gb.points.csv" --out "$T/gb" >/dev/null 2>&1
 prefix "$T/gb/gap-benchmark.md" gap-benchmark.md
 same "$T/gb/gap-benchmark.json" gap-benchmark.json; same "$T/gb/gap-benchmark.svg" gap-benchmark.svg
+"$S" gap benchmark --design zippy --quick --merge reports/gap-benchmark-zippy.points.csv \
+  --points "$T/gz.points.csv" --out "$T/gz" >/dev/null 2>&1
+prefix "$T/gz/gap-benchmark.md" gap-benchmark-zippy/gap-benchmark.md
+same "$T/gz/gap-benchmark.json" gap-benchmark-zippy/gap-benchmark.json
+same "$T/gz/gap-benchmark.svg" gap-benchmark-zippy/gap-benchmark.svg
 echo "$fails report(s) differ"
 [ "$fails" -eq 0 ]

@@ -236,6 +236,16 @@ pub struct SelectionArgs {
     /// (μ beside the stiction speed, the servo gain beside its torque limit).
     #[arg(long)]
     pub audit_undeclared: bool,
+    /// Experimental: count the model's own trial-to-trial spread as noise. The nominal is
+    /// walked at every condition from N starts perturbed by the design's [initial] seed table,
+    /// and the sd of each metric over them (and the unperturbed walk) is added to the
+    /// measurement's sd. A stable gait forgets its start (no change); an irregular one
+    /// (Zippy's) does not, and a fit to a few cycles of it chases their chance. Off (0): on
+    /// Zippy's benchmark (N = 4, 68 cases) it cleared 2 wrong names (μ for an undeclared
+    /// contact stiffness and stiction speed) but made 3 others and named 7 of 24 single
+    /// effects instead of 12 (reports/gap-benchmark-zippy/gap-benchmark.md)
+    #[arg(long, value_name = "N", default_value_t = 0)]
+    pub model_spread: u64,
 }
 
 impl SelectionArgs {
@@ -281,6 +291,9 @@ impl SelectionArgs {
         flag(self.walked_lm, "walked-lm");
         flag(self.look_alikes_at_end, "look-alikes-at-end");
         flag(self.audit_undeclared, "audit-undeclared");
+        if self.model_spread > 0 {
+            f.push_str(&format!(" --model-spread {}", self.model_spread));
+        }
         if let Some(n) = self.exchange_rounds {
             f.push_str(&format!(" --exchange-rounds {n}"));
         }
@@ -755,6 +768,7 @@ fn diagnose(a: &DiagnoseArgs) -> anyhow::Result<ExitCode> {
         calibrate: !a.no_calibration,
         select: a.selection.options(),
         audit_undeclared: a.selection.audit_undeclared,
+        model_spread_seeds: a.selection.model_spread,
         ..DiagnoseOptions::default()
     };
     let pb = Progress::Spinner(indicatif::ProgressBar::new_spinner());
@@ -850,6 +864,7 @@ fn benchmark(a: &BenchmarkArgs) -> anyhow::Result<ExitCode> {
     }
     opts.select = a.selection.options();
     opts.audit_undeclared = a.selection.audit_undeclared;
+    opts.model_spread_seeds = a.selection.model_spread;
     if let Some(n) = &a.noise {
         if let Some(bad) = n.iter().find(|x| !(**x > 0.0 && **x < 1.0)) {
             anyhow::bail!("--noise {bad}: each level must be a fraction in (0, 1)");

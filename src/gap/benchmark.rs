@@ -99,6 +99,14 @@ pub struct BenchmarkOptions {
     /// signature only when on.
     #[serde(default, skip_serializing_if = "std::ops::Not::not")]
     pub audit_undeclared: bool,
+    /// The model's spread over this many perturbed starts counted as noise in every case
+    /// ([`super::diagnose::model_spread`]); written into the signature only when > 0.
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub model_spread_seeds: u64,
+}
+
+fn is_zero(n: &u64) -> bool {
+    *n == 0
 }
 
 impl BenchmarkOptions {
@@ -131,6 +139,7 @@ impl BenchmarkOptions {
             effects: Vec::new(),
             select: SelectOptions::default(),
             audit_undeclared: false,
+            model_spread_seeds: 0,
         }
     }
 }
@@ -378,6 +387,7 @@ pub struct Plan {
     /// The selection's options of every case (the rules the run asks for).
     select: SelectOptions,
     audit_undeclared: bool,
+    model_spread_seeds: u64,
     suites: Vec<Suite>,
     drake: BTreeMap<String, (TrialSet, Vec<SimMetrics>)>,
 }
@@ -461,6 +471,7 @@ pub fn plan(
         thresholds: thr.table,
         select: opts.select.clone(),
         audit_undeclared: opts.audit_undeclared,
+        model_spread_seeds: opts.model_spread_seeds,
         suites,
         drake,
     })
@@ -899,6 +910,7 @@ fn run_case(
         identifiability: false,
         select: plan.select.clone(),
         audit_undeclared: plan.audit_undeclared,
+        model_spread_seeds: plan.model_spread_seeds,
         ..DiagnoseOptions::default()
     };
     let walks0 = suite.cache.walks();

@@ -18,12 +18,12 @@ use super::curve::Curve;
 use super::error::GapError;
 use super::fit::{Fit, FitContext, ProfileInterval, dispersion, groupings, lr_p_value};
 use super::identify::{Identifiability, identifiability};
-use super::knob::{KnobKind, Knobs};
+use super::knob::{KnobKind, Knobs, ModelSetting};
 use super::library::EffectLibrary;
 use super::locate::{MetricGap, Residual, metric_gaps, summarize};
 use super::problem::Observation;
 use super::select::{SelectOptions, Step, gap_of, select, within_noise};
-use super::simulate::{Condition, resolve};
+use super::simulate::{Condition, SimMetrics, resolve};
 use super::surrogate::Surrogate;
 use super::trials::{Metric, TrialSet};
 use crate::progress::{Observer, Stopwatch};
@@ -52,6 +52,9 @@ pub struct DiagnoseOptions {
     /// ([`super::audit`]): a named knob that one of them, in its place, fits as well is not
     /// named.
     pub audit_undeclared: bool,
+    /// Count the model's own trial-to-trial spread as an error beside each measurement's:
+    /// the nominal walked from this many perturbed starts ([`model_spread`]); 0: off.
+    pub model_spread_seeds: u64,
 }
 
 impl Default for DiagnoseOptions {
@@ -66,6 +69,7 @@ impl Default for DiagnoseOptions {
             explanations: true,
             select: SelectOptions::default(),
             audit_undeclared: false,
+            model_spread_seeds: 0,
         }
     }
 }
@@ -499,8 +503,16 @@ pub fn diagnose_conditions(
 ) -> Result<(Diagnosis, Timing), GapError> {
     check_options(opts)?;
     let candidates = lib.subset(&opts.effects)?;
-    let (filled, obs, mut notes) = measured(set, conditions, lib, opts.default_relative_sd)?;
+    let (filled, mut obs, mut notes) = measured(set, conditions, lib, opts.default_relative_sd)?;
     let set = &filled;
+    if opts.model_spread_seeds > 0 {
+        progress.stage("the model's spread over perturbed starts");
+        let spread = model_spread(conditions, lib, opts.model_spread_seeds)?;
+        notes.push(spread_note(&obs, &spread, set, opts.model_spread_seeds));
+        for o in &mut obs {
+            o.sd = o.sd.hypot(spread[o.trial][o.metric.index()]);
+        }
+    }
     let designs = designs_of(conditions);
     let knobs = Knobs::build(&designs, &candidates, opts.calibrate).map_err(|e| GapError::Sim {
         origin: set.origin.clone(),
@@ -842,6 +854,79 @@ fn calibrated(ctx: &FitContext<'_>, r: &Fit) -> Vec<Calibrated> {
             }
         })
         .collect()
+}
+
+/// The model's own trial-to-trial spread: the sd of each condition's metrics over the
+/// nominal's walk and `seeds` walks from starts perturbed as the design's `[initial]`
+/// seed table says. A stable limit cycle forgets its start (sd ≈ 0); an irregular gait does
+/// not, and a trial of a few cycles then samples its variability, which a fit cannot remove —
+/// a zippy trial's answer flipped under a relative change of 1e-16 in an undeclared
+/// number (reports/gap-benchmark-zippy.md). A fall among the walks gives the metric's size.
+pub fn model_spread(
+    conditions: &[Condition],
+    lib: &EffectLibrary,
+    seeds: u64,
+) -> Result<Vec<[f64; 8]>, GapError> {
+    use rayon::prelude::*;
+    let nominal = ModelSetting::nominal();
+    let jobs: Vec<(usize, Option<u64>)> = (0..conditions.len())
+        .flat_map(|i| std::iter::once((i, None)).chain((1..=seeds).map(move |s| (i, Some(s)))))
+        .collect();
+    let runs: Vec<SimMetrics> = jobs
+        .par_iter()
+        .map(|&(i, seed)| conditions[i].simulate_from(lib, &nominal, seed))
+        .collect::<Result<_, _>>()?;
+    let per = 1 + seeds as usize;
+    Ok(runs
+        .chunks(per)
+        .map(|walks| {
+            let mut sd = [0.0; 8];
+            for (m, out) in sd.iter_mut().enumerate() {
+                let finite: Vec<f64> = walks
+                    .iter()
+                    .map(|w| w.values[m])
+                    .filter(|v| v.is_finite())
+                    .collect();
+                if finite.is_empty() {
+                    continue;
+                }
+                let mean = finite.iter().sum::<f64>() / finite.len() as f64;
+                *out = if finite.len() < walks.len() {
+                    mean.abs()
+                } else if finite.len() > 1 {
+                    let ss: f64 = finite.iter().map(|v| (v - mean).powi(2)).sum();
+                    (ss / (finite.len() - 1) as f64).sqrt()
+                } else {
+                    0.0
+                };
+            }
+            sd
+        })
+        .collect())
+}
+
+/// What the model's spread did to the noise: the largest ratio of spread to measurement sd.
+fn spread_note(obs: &[Observation], spread: &[[f64; 8]], set: &TrialSet, seeds: u64) -> String {
+    let worst = obs
+        .iter()
+        .map(|o| (spread[o.trial][o.metric.index()] / o.sd, o))
+        .filter(|(r, _)| r.is_finite())
+        .max_by(|a, b| a.0.total_cmp(&b.0));
+    let inflated = obs
+        .iter()
+        .filter(|o| spread[o.trial][o.metric.index()] > 0.5 * o.sd)
+        .count();
+    match worst {
+        Some((r, o)) => format!(
+            "model spread ({seeds} perturbed starts per condition) counted beside the noise: \
+             {inflated} of {} measurements' sds grow by more than 12 %; the largest spread is \
+             {r:.2}× the measurement's sd ({} at {})",
+            obs.len(),
+            o.metric.words(),
+            set.trials[o.trial].name()
+        ),
+        None => format!("model spread ({seeds} perturbed starts per condition): none"),
+    }
 }
 
 /// The answer: the chain's knobs with their intervals, the final model's residual check,

@@ -229,11 +229,33 @@ impl Condition {
         setting: &ModelSetting,
         record: bool,
     ) -> Result<(SimMetrics, Vec<crate::sim::TrajectorySample>), GapError> {
+        self.walk_from(lib, setting, record, None)
+    }
+
+    /// As [`Condition::simulate`], from the design's initial state perturbed by `seed`
+    /// (`initial.seed_*` of the design; None: the unperturbed start every fit uses).
+    pub fn simulate_from(
+        &self,
+        lib: &EffectLibrary,
+        setting: &ModelSetting,
+        seed: Option<u64>,
+    ) -> Result<SimMetrics, GapError> {
+        self.walk_from(lib, setting, false, seed).map(|(m, _)| m)
+    }
+
+    fn walk_from(
+        &self,
+        lib: &EffectLibrary,
+        setting: &ModelSetting,
+        record: bool,
+        seed: Option<u64>,
+    ) -> Result<(SimMetrics, Vec<crate::sim::TrajectorySample>), GapError> {
         let d = self.design_with(lib, setting)?;
         let f = d.controller().frequency_hz().unwrap_or(1.0);
         let opts = WalkOptions {
             duration_s: CYCLES_PER_TRIAL / f,
             record_trajectory: record,
+            seed,
             ..WalkOptions::default()
         };
         let r = simulate_walk(&d, &opts).map_err(|e| GapError::Sim {

@@ -8,6 +8,7 @@ mod drake_crosscheck;
 mod gap;
 mod gap_cases;
 mod gap_open;
+mod gap_spread;
 mod gap_waveform;
 mod live_dataset;
 mod load_fuzz;
