@@ -74,7 +74,10 @@ fn an_unperturbed_start_has_no_spread() {
             "seed_rate_sd_over_sqrt_g_over_l = 0.02",
             "seed_rate_sd_over_sqrt_g_over_l = 0.0",
         );
-    assert_ne!(still, zippy, "zippy.toml's seed table changed: update this test");
+    assert_ne!(
+        still, zippy,
+        "zippy.toml's seed table changed: update this test"
+    );
     std::fs::write(dir.path().join("still.toml"), still).expect("write");
     let lib = EffectLibrary::bundled().expect("library");
     let set = TrialSet::parse(&TRIAL.replace("DESIGN", "still.toml"), "t.csv", dir.path())
