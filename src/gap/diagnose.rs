@@ -860,8 +860,9 @@ fn calibrated(ctx: &FitContext<'_>, r: &Fit) -> Vec<Calibrated> {
 /// nominal's walk and `seeds` walks from starts perturbed as the design's `[initial]`
 /// seed table says. A stable limit cycle forgets its start (sd ≈ 0); an irregular gait does
 /// not, and a trial of a few cycles then samples its variability, which a fit cannot remove —
-/// a zippy trial's answer flipped under a relative change of 1e-16 in an undeclared
-/// number (reports/gap-benchmark-zippy.md). A fall among the walks gives the metric's size.
+/// a Zippy trial's answer flipped under a relative change of 2e-16 in an undeclared
+/// number (reports/gap-benchmark-zippy/gap-benchmark.md). Spread per metric:
+/// [`super::simulate::metric_spread`].
 pub fn model_spread(
     conditions: &[Condition],
     lib: &EffectLibrary,
@@ -876,32 +877,9 @@ pub fn model_spread(
         .par_iter()
         .map(|&(i, seed)| conditions[i].simulate_from(lib, &nominal, seed))
         .collect::<Result<_, _>>()?;
-    let per = 1 + seeds as usize;
     Ok(runs
-        .chunks(per)
-        .map(|walks| {
-            let mut sd = [0.0; 8];
-            for (m, out) in sd.iter_mut().enumerate() {
-                let finite: Vec<f64> = walks
-                    .iter()
-                    .map(|w| w.values[m])
-                    .filter(|v| v.is_finite())
-                    .collect();
-                if finite.is_empty() {
-                    continue;
-                }
-                let mean = finite.iter().sum::<f64>() / finite.len() as f64;
-                *out = if finite.len() < walks.len() {
-                    mean.abs()
-                } else if finite.len() > 1 {
-                    let ss: f64 = finite.iter().map(|v| (v - mean).powi(2)).sum();
-                    (ss / (finite.len() - 1) as f64).sqrt()
-                } else {
-                    0.0
-                };
-            }
-            sd
-        })
+        .chunks(1 + seeds as usize)
+        .map(super::simulate::metric_spread)
         .collect())
 }
 

@@ -705,24 +705,9 @@ impl<'a> FitContext<'a> {
             }
             runs.push(self.walks(&p)?);
         }
-        let mut out = vec![[0.0; 8]; n_cond];
-        for (c, row) in out.iter_mut().enumerate() {
-            for m in super::trials::Metric::ALL {
-                let v: Vec<f64> = runs.iter().map(|r| r[c].get(m)).collect();
-                let finite: Vec<f64> = v.iter().copied().filter(|x| x.is_finite()).collect();
-                row[m.index()] = if finite.is_empty() {
-                    0.0
-                } else if finite.len() < v.len() {
-                    finite.iter().map(|x| x.abs()).fold(0.0, f64::max)
-                } else {
-                    let mean = finite.iter().sum::<f64>() / finite.len() as f64;
-                    (finite.iter().map(|x| (x - mean).powi(2)).sum::<f64>()
-                        / (finite.len() - 1) as f64)
-                        .sqrt()
-                };
-            }
-        }
-        Ok(out)
+        Ok((0..n_cond)
+            .map(|c| super::simulate::metric_spread(runs.iter().map(|r| &r[c])))
+            .collect())
     }
 
     /// The Jacobian of the residuals ([`Self::residuals`]) in the unit coordinates of

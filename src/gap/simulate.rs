@@ -273,6 +273,33 @@ impl Condition {
     }
 }
 
+/// The spread of one condition's metrics over several walks of it: each metric's sample sd
+/// (n − 1); where some walks fell and others did not, the largest |value| (the metric's own
+/// size: a fall is as far off as the metric can be); 0 where every walk fell.
+pub fn metric_spread<'a>(walks: impl IntoIterator<Item = &'a SimMetrics>) -> [f64; 8] {
+    let walks: Vec<&SimMetrics> = walks.into_iter().collect();
+    let mut out = [0.0; 8];
+    for (m, row) in out.iter_mut().enumerate() {
+        let finite: Vec<f64> = walks
+            .iter()
+            .map(|w| w.values[m])
+            .filter(|x| x.is_finite())
+            .collect();
+        *row = if finite.is_empty() {
+            0.0
+        } else if finite.len() < walks.len() {
+            finite.iter().map(|x| x.abs()).fold(0.0, f64::max)
+        } else if finite.len() > 1 {
+            let mean = finite.iter().sum::<f64>() / finite.len() as f64;
+            (finite.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / (finite.len() - 1) as f64)
+                .sqrt()
+        } else {
+            0.0
+        };
+    }
+    out
+}
+
 /// Simulates many (condition, setting) jobs in parallel, in order.
 pub fn simulate_jobs(
     jobs: &[(usize, ModelSetting)],
