@@ -60,12 +60,12 @@ fn case(
         Some(seed),
         candidates,
         calibrate,
-        SelectOptions::default(),
+        SelectOptions::default().into(),
     )
 }
 
-/// The same with the selection's options, and the expected (noise-free) trials when `seed`
-/// is None.
+/// The same with the selection's options and the undeclared-parameter audit on or off, and
+/// the expected (noise-free) trials when `seed` is None.
 fn case_with(
     params: &[(&str, f64)],
     effects: &[(&str, f64)],
@@ -73,7 +73,7 @@ fn case_with(
     seed: Option<u64>,
     candidates: &[&str],
     calibrate: bool,
-    select: SelectOptions,
+    rules: Rules,
 ) -> Diagnosis {
     let s = six();
     let design = &s.conditions[0].design;
@@ -103,8 +103,8 @@ fn case_with(
         calibrate,
         explanations: false,
         identifiability: false,
-        select,
-        audit_undeclared: AUDIT.with(|a| a.get()),
+        select: rules.select,
+        audit_undeclared: rules.audit_undeclared,
         ..DiagnoseOptions::default()
     };
     diagnose_conditions(&set, &s.conditions, &s.lib, &opts, &s.cache, &Silent)
@@ -112,9 +112,19 @@ fn case_with(
         .0
 }
 
-thread_local! {
-    /// The undeclared-parameter audit in `case_with` (off unless a test turns it on).
-    static AUDIT: std::cell::Cell<bool> = const { std::cell::Cell::new(false) };
+/// The selection's rules of a `case_with` and the undeclared-parameter audit.
+struct Rules {
+    select: SelectOptions,
+    audit_undeclared: bool,
+}
+
+impl From<SelectOptions> for Rules {
+    fn from(select: SelectOptions) -> Rules {
+        Rules {
+            select,
+            audit_undeclared: false,
+        }
+    }
 }
 
 fn names(d: &Diagnosis) -> (Vec<String>, Vec<String>) {
@@ -380,6 +390,7 @@ fn walked_levenberg_marquardt_lets_a_pair_beat_a_dozen_parameter_recalibration()
             "hip_backlash",
         ],
         &select,
+        false,
         &SimCache::default(),
     );
     assert_pair_named(
@@ -394,6 +405,7 @@ fn diagnose_committed(
     file: &str,
     effects: &[&str],
     select: &SelectOptions,
+    audit_undeclared: bool,
     cache: &SimCache,
 ) -> Diagnosis {
     let s = six();
@@ -405,6 +417,7 @@ fn diagnose_committed(
         explanations: false,
         identifiability: false,
         select: select.clone(),
+        audit_undeclared,
         ..DiagnoseOptions::default()
     };
     diagnose_conditions(&set, &conditions, &s.lib, &opts, cache, &Silent)
@@ -428,10 +441,10 @@ fn plain_and_each(
     selects: &[SelectOptions],
 ) -> (Diagnosis, Vec<Diagnosis>) {
     let cache = SimCache::default();
-    let plain = diagnose_committed(file, effects, &SelectOptions::plain(), &cache);
+    let plain = diagnose_committed(file, effects, &SelectOptions::plain(), false, &cache);
     let with = selects
         .iter()
-        .map(|select| diagnose_committed(file, effects, select, &cache))
+        .map(|select| diagnose_committed(file, effects, select, false, &cache))
         .collect();
     (plain, with)
 }
@@ -568,6 +581,7 @@ fn intervals_of_two_named_knobs_that_trade_off_hold_both_truths() {
         "rolling-slope-3pct-bench.csv",
         &["rolling_resistance", "hip_viscous_damping"],
         &SelectOptions::default(),
+        false,
         &SimCache::default(),
     );
     assert_eq!(d.answer.kind, AnswerKind::Both, "{}", d.answer.statement);
@@ -671,7 +685,7 @@ fn the_look_ahead_check_unnames_a_look_alike_that_won_the_first_step() {
         None,
         &candidates,
         false,
-        SelectOptions::plain(),
+        SelectOptions::plain().into(),
     );
     assert_eq!(
         names(&plain).1,
@@ -680,7 +694,15 @@ fn the_look_ahead_check_unnames_a_look_alike_that_won_the_first_step() {
         plain.answer.statement
     );
     for seed in [None, Some(1), Some(2)] {
-        let d = case_with(&[], &pair, 0.03, seed, &candidates, false, look.clone());
+        let d = case_with(
+            &[],
+            &pair,
+            0.03,
+            seed,
+            &candidates,
+            false,
+            look.clone().into(),
+        );
         let (params, effects) = names(&d);
         assert!(params.is_empty(), "{}", d.answer.statement);
         assert!(
@@ -702,7 +724,7 @@ fn the_look_ahead_check_unnames_a_look_alike_that_won_the_first_step() {
                 seed,
                 &candidates,
                 false,
-                look.clone(),
+                look.clone().into(),
             );
             assert_eq!(
                 names(&d).1,
@@ -738,7 +760,7 @@ fn the_look_ahead_check_keeps_a_true_effect_beside_an_undeclared_error() {
                 "friction_coefficient",
             ],
             true,
-            look.clone(),
+            look.clone().into(),
         );
         let (params, effects) = names(&d);
         assert!(params.is_empty(), "seed {seed:?}: {}", d.answer.statement);
@@ -1366,21 +1388,9 @@ fn audit_tables_are_checked_and_name_the_field() {
 fn the_audit_unnames_a_stand_in_for_an_undeclared_number() {
     let cache = SimCache::default();
     let effects = ["rolling_resistance", "hip_viscous_damping"];
-    let file = "roll-inertia-mu-3pct.csv";
+    let select = SelectOptions::default();
     let run = |audit: bool| {
-        let s = six();
-        let set = TrialSet::read(&repo().join("tests/data/gap").join(file)).expect("trials");
-        let conditions = resolve(&set).expect("resolve");
-        let opts = DiagnoseOptions {
-            effects: effects.iter().map(|e| e.to_string()).collect(),
-            explanations: false,
-            identifiability: false,
-            audit_undeclared: audit,
-            ..DiagnoseOptions::default()
-        };
-        diagnose_conditions(&set, &conditions, &s.lib, &opts, &cache, &Silent)
-            .expect("diagnosis")
-            .0
+        diagnose_committed("roll-inertia-mu-3pct.csv", &effects, &select, audit, &cache)
     };
     let without = run(false);
     assert_eq!(
@@ -1425,16 +1435,18 @@ fn the_audit_unnames_a_stand_in_for_an_undeclared_number() {
 /// slope's place fits as well, so the slope stays named, its interval holding the truth.
 #[test]
 fn the_audit_keeps_a_declared_cause_named() {
-    AUDIT.with(|a| a.set(true));
-    let d = case(
+    let d = case_with(
         &[("ground.slope_deg", 1.5)],
         &[],
         0.03,
-        5,
+        Some(5),
         &["hip_coulomb_friction", "rolling_resistance"],
         true,
+        Rules {
+            select: SelectOptions::default(),
+            audit_undeclared: true,
+        },
     );
-    AUDIT.with(|a| a.set(false));
     assert_eq!(
         names(&d),
         (vec![format!("{TEST_DESIGN}:ground.slope_deg")], Vec::new()),
