@@ -80,13 +80,15 @@ pub fn main() -> ExitCode {
 }
 
 /// The error and its causes, "outer: cause: …", leaving out a cause whose text the message
-/// already holds (most of the crate's errors print their source inside their own message,
-/// and `{:#}` would repeat it).
+/// already ends with (most of the crate's errors print their source at the end of their own
+/// message, "{path}: {source}", and `{:#}` would repeat it). Only a repeat at the end is
+/// dropped: a short cause that happens to appear mid-message is still printed, so no cause is
+/// ever lost.
 pub fn error_chain(e: &anyhow::Error) -> String {
     let mut message = String::new();
     for cause in e.chain() {
         let text = cause.to_string();
-        if message.contains(&text) {
+        if !text.is_empty() && message.ends_with(&text) {
             continue;
         }
         if !message.is_empty() {
@@ -109,5 +111,52 @@ fn run(cli: Cli) -> anyhow::Result<ExitCode> {
         Command::Sim(a) => sim::run(&a),
         Command::Gap(a) => gap::run(&a),
         Command::TorqueCheck(a) => study::torque_check(&a),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::error_chain;
+
+    #[derive(Debug)]
+    struct Wrapped {
+        text: String,
+        source: std::io::Error,
+    }
+    impl std::fmt::Display for Wrapped {
+        fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+            f.write_str(&self.text)
+        }
+    }
+    impl std::error::Error for Wrapped {
+        fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
+            Some(&self.source)
+        }
+    }
+
+    fn chain_of(text: &str, cause: &str) -> String {
+        let e = Wrapped {
+            text: text.to_string(),
+            source: std::io::Error::other(cause.to_string()),
+        };
+        error_chain(&anyhow::Error::new(e))
+    }
+
+    #[test]
+    fn a_cause_printed_at_the_end_of_its_message_is_not_repeated() {
+        assert_eq!(
+            chain_of("/x.csv: no such file", "no such file"),
+            "/x.csv: no such file"
+        );
+    }
+
+    #[test]
+    fn a_cause_found_only_mid_message_is_kept() {
+        // "bad" appears inside the message but is not its source's rendering at the end
+        assert_eq!(
+            chain_of("bad row 3 in x.csv", "bad"),
+            "bad row 3 in x.csv: bad"
+        );
+        assert_eq!(chain_of("reading x.csv", "denied"), "reading x.csv: denied");
     }
 }
