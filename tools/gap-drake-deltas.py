@@ -8,7 +8,10 @@ of 3 % of the metric, over the 9 conditions x 7 metrics. If the changes agreed, 
 diagnosis could subtract the engine difference (a baseline of the same robot without the
 effect) and name the effect on top of it. Usage (repository root, release build):
 
-    python3 tools/gap-drake-deltas.py [path/to/survey]
+    python3 tools/gap-drake-deltas.py [path/to/survey] [drake trials folder]
+
+The folder (default tests/golden/drake/gap, SAP) holds one conditions-*.csv and the
+trials-*.csv made from it; tests/golden/drake/gap-lagged holds Drake-Lagged's.
 """
 import csv
 import math
@@ -19,7 +22,8 @@ import tempfile
 from pathlib import Path
 
 SURVEY = sys.argv[1] if len(sys.argv) > 1 else "target/release/survey"
-D = Path("tests/golden/drake/gap")
+D = Path(sys.argv[2] if len(sys.argv) > 2 else "tests/golden/drake/gap")
+CONDITIONS = next(iter(sorted(D.glob("conditions-*.csv"))))
 METRICS = ["velocity_mps", "step_frequency_hz", "roll_pp_deg", "pitch_pp_deg",
            "yaw_pp_deg", "peak_torque_nm", "cot"]
 # Every Drake trials file with an effect, named trials-<effect>-<value>.csv as the
@@ -34,8 +38,12 @@ def load(path):
 
 
 def synth(out, effect=None):
-    cmd = [SURVEY, "gap", "synth", "--design", "mugatu-ref", "--conditions",
-           str(D / "conditions-mugatu-ref.csv"), "--noise", "0.03", "--expected", "--out", out]
+    # the design of the conditions' first row (a bundled name or a path relative to them)
+    with open(CONDITIONS) as f:
+        first = next(csv.DictReader(l for l in f if not l.startswith("#")))["design"]
+    design = str(CONDITIONS.parent / first) if first.endswith(".toml") else first
+    cmd = [SURVEY, "gap", "synth", "--design", design, "--conditions",
+           str(CONDITIONS), "--noise", "0.03", "--expected", "--out", out]
     if effect:
         cmd += ["--effect", effect]
     subprocess.run(cmd, check=True, capture_output=True)

@@ -317,6 +317,9 @@ def main(argv=None):
     t.add_argument("--out", required=True, help="output trials CSV")
     t.add_argument("--jobs", type=int, default=2, help="parallel processes (default 2); "
                                                        "does not change the output")
+    t.add_argument("--approximation", choices=["sap", "similar", "lagged"],
+                   help="Drake's discrete contact approximation (default as for walk); lagged "
+                        "needs a Hunt-Crossley design")
     c = sub.add_parser("case", help="run one elementary case")
     c.add_argument("name")
     c.add_argument("--cases", default="tests/golden/drake/cases.toml")
@@ -338,7 +341,8 @@ def main(argv=None):
 
     if args.cmd == "trials":
         import trials as tz
-        return tz.run_trials(args.conditions, args.out, args.effect, jobs=args.jobs)
+        return tz.run_trials(args.conditions, args.out, args.effect, jobs=args.jobs,
+                             approximation=args.approximation)
     if args.cmd == "walk":
         do_walk(args.design, leg_length=args.leg_length, mass_law=args.mass_law,
                 contact_scaling=args.contact_scaling, frequency=args.frequency,

@@ -158,7 +158,7 @@ def _run_row(job):
     """Worker: one trial condition -> metrics (runs in its own process)."""
     import walk as wk
     import harness as hz
-    idx, row, design_path, settings = job
+    idx, row, design_path, settings, approximation = job
     t0 = time.perf_counter()
     torque = row["torque_limit_nm"] if row["torque_limit_nm"] is not None else row["torque_nm"]
     mass_law = row.get("mass_law") or "l2"
@@ -173,9 +173,16 @@ def _run_row(job):
             raise TrialsError(f"row {row['_line']}: torque_limit_nm is for position-servo "
                               "designs, torque_nm for bang-bang ones")
     model = dz.build_model(d)
+    if approximation is not None:
+        kv = model.dissipation_kind == "kelvin_voigt"
+        if kv != (approximation == "sap"):
+            raise TrialsError(
+                f"--approximation {approximation}: SAP uses the relaxation time and the others "
+                f"Hunt-Crossley dissipation; {design_path} has "
+                + ("relaxation_time_s" if kv else "hunt_crossley_dissipation_s_per_m"))
     freq = model.controller["frequency_hz"]
     duration = CYCLES_PER_TRIAL / freq
-    run = wk.run_walk(model, duration)
+    run = wk.run_walk(model, duration, approximation=approximation)
     torque_limit = model.controller.get("torque_limit_nm", model.controller.get("torque_nm"))
     report = wk.analyze(
         run["samples"], name=model.name, leg_length_m=model.leg_length_m,
@@ -206,7 +213,9 @@ def _design_cell(name: str, cond_dir: Path, out_dir: Path) -> str:
     return Path(os.path.relpath(p, out_dir.resolve())).as_posix()
 
 
-def run_trials(conditions, out, effect_args, jobs: int = 2) -> int:
+def run_trials(conditions, out, effect_args, jobs: int = 2, approximation=None) -> int:
+    """approximation: Drake's discrete contact approximation (None: sap for a relaxation-time
+    design, similar for a Hunt-Crossley one; 'lagged' is the non-convex one)."""
     import harness as hz
     t_start = time.perf_counter()
     cond_path = Path(conditions)
@@ -223,10 +232,13 @@ def run_trials(conditions, out, effect_args, jobs: int = 2) -> int:
     command = "python tools/drake/harness.py trials " + hz.rel(cond_path)
     for e in effect_args:
         command += f" --effect {e}"
+    if approximation is not None:
+        command += f" --approximation {approximation}"
     command += " --out " + hz.rel(out_path)
     source = f"{command} (Drake {hz.drake_version()})"
     n = len(rows)
-    jobs_list = [(i, r, str(p), settings) for i, (r, p) in enumerate(zip(rows, designs))]
+    jobs_list = [(i, r, str(p), settings, approximation)
+                 for i, (r, p) in enumerate(zip(rows, designs))]
     print(f"{n} trials, {max(1, jobs)} processes; effects: "
           + (", ".join(effect_args) if effect_args else "none"), flush=True)
     results = [None] * n
