@@ -61,5 +61,12 @@ same "$T/gb/gap-benchmark.json" gap-benchmark.json; same "$T/gb/gap-benchmark.sv
 prefix "$T/gz/gap-benchmark.md" gap-benchmark-zippy/gap-benchmark.md
 same "$T/gz/gap-benchmark.json" gap-benchmark-zippy/gap-benchmark.json
 same "$T/gz/gap-benchmark.svg" gap-benchmark-zippy/gap-benchmark.svg
+"$S" gap benchmark --design mugatu --quick --noise 0.03,0.05 --null-cases 300 --one-robot-nulls 100 \
+  --drake tests/golden/drake/gap-lagged --drake-seeds 3 --drake-reference \
+  --merge reports/gap-benchmark-drake-lagged.points.csv \
+  --points "$T/gl.points.csv" --out "$T/gl" >/dev/null 2>&1
+prefix "$T/gl/gap-benchmark.md" gap-benchmark-drake-lagged/gap-benchmark.md
+same "$T/gl/gap-benchmark.json" gap-benchmark-drake-lagged/gap-benchmark.json
+same "$T/gl/gap-benchmark.svg" gap-benchmark-drake-lagged/gap-benchmark.svg
 echo "$fails report(s) differ"
 [ "$fails" -eq 0 ]

@@ -151,6 +151,15 @@ pub struct DiagnoseArgs {
     /// Figure of the standardised residuals per condition, before and after (SVG or PNG).
     #[arg(long, value_name = "FILE")]
     pub plot: Option<PathBuf>,
+    /// Trials CSV of the same robot without the change asked about (before a damper, on the
+    /// old floor, the same model without an effect), at the same conditions. The diagnosis
+    /// is then of the change: each metric is carried onto the model as nominal + (trial −
+    /// reference), so a discrepancy the model has everywhere (another engine, an unmodelled
+    /// structure) cancels. Trust it where the model's gait is like the robot's: an effect
+    /// must change both alike (Drake with physical friction: yes; with SAP's convex
+    /// friction: no; reports/gap-benchmark-drake-lagged/)
+    #[arg(long, value_name = "FILE")]
+    pub reference: Option<PathBuf>,
     #[command(flatten)]
     pub selection: SelectionArgs,
 }
@@ -465,6 +474,14 @@ pub struct BenchmarkArgs {
     /// Folder of Drake trials files (`trials-*.csv`, e.g. tests/golden/drake/gap).
     #[arg(long, value_name = "DIR")]
     pub drake: Option<PathBuf>,
+    /// Diagnose each Drake case relative to a noisy copy of the folder's `trials-none.csv`
+    /// (another seed): `gap diagnose --reference`, the diagnosis of what the added effect
+    /// changed, with the engine difference taken from the no-effect trials.
+    #[arg(long, requires = "drake")]
+    pub drake_reference: bool,
+    /// Noisy copies of each Drake trials file (default 5; 1 with --quick).
+    #[arg(long, value_name = "N", requires = "drake")]
+    pub drake_seeds: Option<u64>,
     /// Effects to benchmark (default: all).
     #[arg(long, value_delimiter = ',')]
     pub effects: Vec<String>,
@@ -760,7 +777,9 @@ fn waveform_benchmark(a: &WaveformBenchArgs) -> anyhow::Result<ExitCode> {
 fn diagnose(a: &DiagnoseArgs) -> anyhow::Result<ExitCode> {
     let lib = EffectLibrary::bundled()?;
     let set = TrialSet::read(&a.trials)?;
+    let reference = a.reference.as_deref().map(TrialSet::read).transpose()?;
     let opts = DiagnoseOptions {
+        reference,
         effects: a.effects.clone(),
         grid_points: a.grid,
         default_relative_sd: a.default_sd,
@@ -785,15 +804,16 @@ fn diagnose(a: &DiagnoseArgs) -> anyhow::Result<ExitCode> {
     // Look-alike groups the summaries left, separated with the trials' logs (when they have
     // any). Text only: the JSON stays the diagnosis (`survey gap separate --format json`
     // gives a group's separation as JSON).
+    // Not with a reference: the carried numbers are no longer the logs' own.
     let follow = match a.format {
-        GapFormat::Text => gap::separate::follow_up(
+        GapFormat::Text if opts.reference.is_none() => gap::separate::follow_up(
             &d,
             &set,
             &lib,
             &gap::separate::SeparateOptions::default(),
             &Silent,
         )?,
-        GapFormat::Json => Vec::new(),
+        GapFormat::Text | GapFormat::Json => Vec::new(),
     };
     print(&match a.format {
         GapFormat::Json => report::json(&d)?,
@@ -856,6 +876,12 @@ fn benchmark(a: &BenchmarkArgs) -> anyhow::Result<ExitCode> {
     if let Some(n) = a.null_cases {
         opts.null_cases = n;
     }
+    if let Some(n) = a.drake_seeds {
+        if n == 0 {
+            anyhow::bail!("--drake-seeds 0: give at least one noisy copy per Drake file");
+        }
+        opts.drake_seeds = n;
+    }
     if let Some(s) = a.seeds {
         opts.seeds = s;
     }
@@ -872,6 +898,7 @@ fn benchmark(a: &BenchmarkArgs) -> anyhow::Result<ExitCode> {
         opts.noise_levels = n.clone();
     }
     opts.drake_dir = a.drake.clone();
+    opts.drake_reference = a.drake_reference;
     opts.effects = a.effects.clone();
     let shard = a.shard.unwrap_or(Shard::WHOLE);
     if shard != Shard::WHOLE && a.points.is_none() {
@@ -961,6 +988,12 @@ fn benchmark(a: &BenchmarkArgs) -> anyhow::Result<ExitCode> {
     }
     if let Some(d) = &a.drake {
         command.push_str(&format!(" --drake {}", d.display()));
+    }
+    if let Some(n) = a.drake_seeds {
+        command.push_str(&format!(" --drake-seeds {n}"));
+    }
+    if a.drake_reference {
+        command.push_str(" --drake-reference");
     }
     std::fs::create_dir_all(&a.out)?;
     let md = report::gap::benchmark_md(&summary, &rows, &command);

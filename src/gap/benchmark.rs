@@ -103,6 +103,10 @@ pub struct BenchmarkOptions {
     /// ([`super::diagnose::model_spread`]); written into the signature only when > 0.
     #[serde(default, skip_serializing_if = "is_zero")]
     pub model_spread_seeds: u64,
+    /// Each Drake case diagnosed relative to a noisy copy (another seed) of the folder's
+    /// `trials-none.csv` ([`super::reference`]); written into the signature only when on.
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub drake_reference: bool,
 }
 
 fn is_zero(n: &u64) -> bool {
@@ -140,6 +144,7 @@ impl BenchmarkOptions {
             select: SelectOptions::default(),
             audit_undeclared: false,
             model_spread_seeds: 0,
+            drake_reference: false,
         }
     }
 }
@@ -388,6 +393,7 @@ pub struct Plan {
     select: SelectOptions,
     audit_undeclared: bool,
     model_spread_seeds: u64,
+    drake_reference: bool,
     suites: Vec<Suite>,
     drake: BTreeMap<String, (TrialSet, Vec<SimMetrics>)>,
 }
@@ -472,6 +478,7 @@ pub fn plan(
         select: opts.select.clone(),
         audit_undeclared: opts.audit_undeclared,
         model_spread_seeds: opts.model_spread_seeds,
+        drake_reference: opts.drake_reference,
         suites,
         drake,
     })
@@ -768,6 +775,9 @@ impl Planner<'_> {
     }
 }
 
+/// Drake's no-effect trials, the reference of `--drake-reference`.
+const DRAKE_NONE: &str = "trials-none.csv";
+
 /// The Drake cases: every `trials-*.csv` of `dir` (named `trials-<effect>-<value>` when
 /// Drake added an effect), `drake_seeds` noisy copies each. Returns the truths by file.
 fn drake_cases(
@@ -789,6 +799,16 @@ fn drake_cases(
         })
         .collect();
     files.sort();
+    if opts.drake_reference
+        && !files
+            .iter()
+            .any(|f| f.file_name() == Some(DRAKE_NONE.as_ref()))
+    {
+        return Err(GapError::File {
+            path: dir.display().to_string(),
+            message: format!("--drake-reference needs the no-effect trials {DRAKE_NONE} here"),
+        });
+    }
     for f in files {
         let set = TrialSet::read(&f)?;
         let name = f
@@ -802,7 +822,7 @@ fn drake_cases(
             .and_then(|(e, v)| Some((e.to_string(), v.parse::<f64>().ok()?)));
         // One suite serves every Drake file: its conditions must be the first file's.
         if let Some((first, _)) = drake.values().next()
-            && !same_conditions(first, &set)
+            && !same_conditions(first, &set)?
         {
             return Err(GapError::File {
                 path: f.display().to_string(),
@@ -842,22 +862,15 @@ pub fn spec(opts: &BenchmarkOptions) -> String {
     )
 }
 
-/// Two trials files hold the same conditions (design, size and every condition column,
-/// in order), whatever they measured.
-fn same_conditions(a: &TrialSet, b: &TrialSet) -> bool {
-    a.trials.len() == b.trials.len()
-        && a.trials.iter().zip(&b.trials).all(|(x, y)| {
-            x.design == y.design
-                && x.leg_length_m == y.leg_length_m
-                && x.mass_kg == y.mass_kg
-                && x.mass_law == y.mass_law
-                && x.contact == y.contact
-                && x.frequency_hz == y.frequency_hz
-                && x.amplitude_deg == y.amplitude_deg
-                && x.torque_limit_nm == y.torque_limit_nm
-                && x.torque_nm == y.torque_nm
-                && x.slope_deg == y.slope_deg
-        })
+/// Two trials files hold the same conditions (each row's design, size and every condition
+/// column, in order: [`super::reference::same_condition`]), whatever they measured.
+fn same_conditions(a: &TrialSet, b: &TrialSet) -> Result<bool, GapError> {
+    let (ca, cb) = (resolve(a)?, resolve(b)?);
+    Ok(ca.len() == cb.len()
+        && ca
+            .iter()
+            .zip(&cb)
+            .all(|(x, y)| super::reference::same_condition(x, y)))
 }
 
 /// Runs one case.
@@ -903,7 +916,31 @@ fn run_case(
         base_dir: suite.base.base_dir.clone(),
         trials,
     };
+    // The reference: Drake's no-effect trials with noise of their own (another seed).
+    let reference = match &case.truth {
+        Truth::Drake { .. } if plan.drake_reference => {
+            let none = DRAKE_NONE.trim_end_matches(".csv");
+            let (_, truth) = plan
+                .drake
+                .get(none)
+                .ok_or_else(|| GapError::Invalid(format!("no Drake trials {none}")))?;
+            let key = format!("{}/reference", case.key);
+            Some(TrialSet {
+                origin: key.clone(),
+                base_dir: suite.base.base_dir.clone(),
+                trials: add_noise(
+                    &suite.base.trials,
+                    truth,
+                    case.noise,
+                    seed_of(&key),
+                    "benchmark",
+                ),
+            })
+        }
+        _ => None,
+    };
     let opts = DiagnoseOptions {
+        reference,
         effects: Vec::new(),
         calibrate: case.calibrate,
         explanations: false,

@@ -55,6 +55,10 @@ pub struct DiagnoseOptions {
     /// Count the model's own trial-to-trial spread as an error beside each measurement's:
     /// the nominal walked from this many perturbed starts ([`model_spread`]); 0: off.
     pub model_spread_seeds: u64,
+    /// Trials of the same robot without the change asked about: the diagnosis is then of
+    /// the change, with the model's discrepancy at each condition taken from them
+    /// ([`super::reference`]).
+    pub reference: Option<TrialSet>,
 }
 
 impl Default for DiagnoseOptions {
@@ -70,6 +74,7 @@ impl Default for DiagnoseOptions {
             select: SelectOptions::default(),
             audit_undeclared: false,
             model_spread_seeds: 0,
+            reference: None,
         }
     }
 }
@@ -503,7 +508,29 @@ pub fn diagnose_conditions(
 ) -> Result<(Diagnosis, Timing), GapError> {
     check_options(opts)?;
     let candidates = lib.subset(&opts.effects)?;
+    let carried = match &opts.reference {
+        Some(reference) => {
+            let reference_conditions = resolve(reference)?;
+            let set = fill_from_trajectories(set, conditions, lib)?;
+            let reference = fill_from_trajectories(reference, &reference_conditions, lib)?;
+            progress.stage("the nominal model at every condition, for the reference");
+            let nominal = cache.get(conditions, lib, &ModelSetting::nominal(), progress)?;
+            Some(super::reference::carry(
+                &set,
+                conditions,
+                &reference,
+                &reference_conditions,
+                &nominal,
+                opts.default_relative_sd,
+            )?)
+        }
+        None => None,
+    };
+    let set = carried.as_ref().map_or(set, |c| &c.set);
     let (filled, mut obs, mut notes) = measured(set, conditions, lib, opts.default_relative_sd)?;
+    if let Some(c) = &carried {
+        notes.extend(c.notes.iter().cloned());
+    }
     let set = &filled;
     if opts.model_spread_seeds > 0 {
         progress.stage("the model's spread over perturbed starts");
@@ -599,6 +626,15 @@ pub fn diagnose_conditions(
             &mut steps,
             opts.alpha,
             opts.grid_points,
+            &mut notes,
+        )?;
+    }
+    if opts.reference.is_some() {
+        super::reference::rivals_within_noise(
+            &ctx,
+            &selection.singles,
+            &mut steps,
+            opts.alpha,
             &mut notes,
         )?;
     }

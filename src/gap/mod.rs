@@ -19,7 +19,9 @@
 //!   the end); [`audit`]: the answer's named knobs against every number the designs do not
 //!   declare (`--audit-undeclared`: one that fits as well in a knob's place unnames it);
 //!   [`diagnose`]: the answer;
-//!   [`locate`]: where the gap lies; [`identify`]: detection and identification thresholds.
+//!   [`locate`]: where the gap lies; [`identify`]: detection and identification thresholds;
+//!   [`reference`]: trials carried onto the model through a reference set of the same
+//!   robot (`--reference`: the diagnosis of what changed between them).
 //! * [`waveform`]: a robot's log (time, hip angle, attitude, torque) reduced to the Fourier
 //!   coefficients of its steady cycle, and their χ² against a simulated cycle;
 //!   [`separate`]: look-alike candidates ranked on summaries and on summaries + cycles;
@@ -49,6 +51,7 @@ pub mod knob;
 pub mod library;
 pub mod locate;
 pub mod problem;
+pub mod reference;
 pub mod select;
 pub mod separate;
 pub mod simulate;

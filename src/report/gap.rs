@@ -632,6 +632,11 @@ fn scores_md(o: &mut String, b: &BenchmarkSummary) {
     );
     let _ = writeln!(o, "|---|---:|---:|---|---:|---|");
     for sc in &b.scores {
+        // No case to count (a run of some kinds only): no rate, rather than "NaN %".
+        if sc.n == 0 {
+            let _ = writeln!(o, "| {} | 0 / 0 | – | – | – | {} |", sc.what, sc.target);
+            continue;
+        }
         let _ = writeln!(
             o,
             "| {} | {} / {} | {:.1} % | {:.1}–{:.1} % | {:.1} % | {} |",

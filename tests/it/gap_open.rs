@@ -76,6 +76,30 @@ fn case_with(
     rules: Rules,
 ) -> Diagnosis {
     let s = six();
+    let set = trials_of(params, effects, noise, seed);
+    let opts = DiagnoseOptions {
+        effects: candidates.iter().map(|e| e.to_string()).collect(),
+        calibrate,
+        explanations: false,
+        identifiability: false,
+        select: rules.select,
+        audit_undeclared: rules.audit_undeclared,
+        ..DiagnoseOptions::default()
+    };
+    diagnose_conditions(&set, &s.conditions, &s.lib, &opts, &s.cache, &Silent)
+        .expect("diagnosis")
+        .0
+}
+
+/// Trials of the six conditions with `params` (path, value at 1×) and `effects` (name, SI at
+/// 1×): `noise` relative sd drawn with `seed`, or the expected (noise-free) trials.
+fn trials_of(
+    params: &[(&str, f64)],
+    effects: &[(&str, f64)],
+    noise: f64,
+    seed: Option<u64>,
+) -> TrialSet {
+    let s = six();
     let design = &s.conditions[0].design;
     let mut setting = ModelSetting::nominal();
     for (p, v) in params {
@@ -90,26 +114,14 @@ fn case_with(
         setting.effects.push(set);
     }
     let truth = truth_metrics(&s.conditions, &s.lib, &setting, &Silent).expect("truth");
-    let set = TrialSet {
+    TrialSet {
         origin: "synthetic".into(),
         base_dir: s.base.base_dir.clone(),
         trials: match seed {
             Some(seed) => add_noise(&s.base.trials, &truth, noise, seed, "test"),
             None => expected_trials(&s.base.trials, &truth, noise, "test"),
         },
-    };
-    let opts = DiagnoseOptions {
-        effects: candidates.iter().map(|e| e.to_string()).collect(),
-        calibrate,
-        explanations: false,
-        identifiability: false,
-        select: rules.select,
-        audit_undeclared: rules.audit_undeclared,
-        ..DiagnoseOptions::default()
-    };
-    diagnose_conditions(&set, &s.conditions, &s.lib, &opts, &s.cache, &Silent)
-        .expect("diagnosis")
-        .0
+    }
 }
 
 /// The selection's rules of a `case_with` and the undeclared-parameter audit.
@@ -1461,5 +1473,177 @@ fn the_audit_keeps_a_declared_cause_named() {
             .any(|n| n.starts_with("undeclared-parameter audit: none of")),
         "{:?}",
         d.notes
+    );
+}
+
+/// `gap diagnose --reference`, worked by hand: each metric carried onto the nominal model as
+/// nominal + (trial − reference), its sd the two sds (a stated sd, or the default 10 % of the
+/// value) and the change × the model's relative miss of the reference combined; a metric the reference lacks is left out with a note naming it; a
+/// trial whose condition has no reference trial is refused by file and line (line 9 of the
+/// conditions file: three comment lines and the header before it).
+#[test]
+fn a_reference_carries_each_metric_onto_the_nominal() {
+    use robot_survey::gap::reference::carry;
+    use robot_survey::gap::simulate::SimMetrics;
+    use robot_survey::gap::trials::Measurement;
+    let s = six();
+    let m = |value: f64, sd: Option<f64>| Some(Measurement { value, sd });
+    let mut set = s.base.clone();
+    let mut reference = s.base.clone();
+    let (v, roll) = (Metric::VelocityMps.index(), Metric::RollPpDeg.index());
+    set.trials[0].measured[v] = m(0.2, Some(0.01));
+    set.trials[0].measured[roll] = m(20.0, None);
+    reference.trials[0].measured[v] = m(0.15, Some(0.02));
+    reference.trials[0].measured[roll] = m(25.0, None);
+    // The second trial's velocity has no reference: left out.
+    set.trials[1].measured[v] = m(0.3, Some(0.01));
+    let mut values = [f64::NAN; 8];
+    values[v] = 0.18;
+    values[roll] = 22.0;
+    let nominal = vec![
+        SimMetrics {
+            values,
+            fell: false
+        };
+        6
+    ];
+    let c = carry(
+        &set,
+        &s.conditions,
+        &reference,
+        &s.conditions,
+        &nominal,
+        0.10,
+    )
+    .expect("carried");
+    let t0 = &c.set.trials[0];
+    let cv = t0.measured[v].expect("velocity carried");
+    assert!((cv.value - 0.23).abs() < 1e-12, "{cv:?}"); // 0.18 + (0.2 − 0.15)
+    // √(0.01² + 0.02² + (0.05 · ρ)²), ρ = |0.15 − 0.18| / 0.15 = 0.2
+    assert!((cv.sd.expect("sd") - 0.0006f64.sqrt()).abs() < 1e-12);
+    let cr = t0.measured[roll].expect("roll carried");
+    assert!((cr.value - 17.0).abs() < 1e-12, "{cr:?}"); // 22 + (20 − 25)
+    // √(2² + 2.5² + (5 · ρ)²), ρ = |25 − 22| / 25 = 0.12
+    assert!((cr.sd.expect("sd") - 10.61f64.sqrt()).abs() < 1e-12);
+    assert!(c.set.trials[1].measured.iter().all(Option::is_none));
+    assert!(
+        c.notes
+            .iter()
+            .any(|n| n.contains("not carried") && n.contains("L1x-f1x velocity_mps")),
+        "{:?}",
+        c.notes
+    );
+    // A reference without the last condition.
+    let mut short = reference.clone();
+    short.trials.pop();
+    let mut short_conditions = s.conditions.clone();
+    short_conditions.pop();
+    let e = carry(
+        &set,
+        &s.conditions,
+        &short,
+        &short_conditions,
+        &nominal,
+        0.10,
+    )
+    .expect_err("a trial without a reference");
+    let text = e.to_string();
+    assert!(
+        text.contains("conditions-6.csv:9:")
+            && text.contains("L2x-f1.03x")
+            && text.contains("no reference trial"),
+        "{text}"
+    );
+}
+
+/// A change diagnosed through a reference where the model misses the robot everywhere: the
+/// robot's foot–floor μ is 0.5, not the design's 0.35 — a number the test design does not
+/// declare, and friction_coefficient is no candidate — so the model cannot be brought within
+/// noise of it. Reference: the robot at 3 % noise; trials (other seeds): the robot with hip
+/// Coulomb friction 0.02 N·m added, with a soft floor (5 MPa) instead, and unchanged.
+/// Without the reference the Coulomb trials are far beyond noise (RMS z > 10). Through it:
+/// the unchanged robot shows no gap; the Coulomb friction's change is explained and put in
+/// one group with its look-alike, hip viscous damping, neither named (carried through a
+/// wrong μ the two marks differ by less than the carrying's own error); the soft floor,
+/// whose mark depends on the friction it acts with (the carrying's premise fails), gets no
+/// name at all.
+#[test]
+fn a_reference_carries_a_change_where_the_model_misses_the_robot() {
+    let s = six();
+    let robot = [("contact.friction_mu", 0.5)];
+    let candidates: Vec<String> = [
+        "hip_viscous_damping",
+        "hip_coulomb_friction",
+        "rolling_resistance",
+        "soft_ground",
+    ]
+    .iter()
+    .map(|e| e.to_string())
+    .collect();
+    let reference = trials_of(&robot, &[], 0.03, Some(11));
+    let diagnose = |set: &TrialSet, reference: Option<&TrialSet>| {
+        let opts = DiagnoseOptions {
+            effects: candidates.clone(),
+            explanations: false,
+            identifiability: false,
+            reference: reference.cloned(),
+            ..DiagnoseOptions::default()
+        };
+        diagnose_conditions(set, &s.conditions, &s.lib, &opts, &s.cache, &Silent)
+            .expect("diagnosis")
+            .0
+    };
+    let coulomb = trials_of(&robot, &[("hip_coulomb_friction", 0.02)], 0.03, Some(12));
+    let plain = diagnose(&coulomb, None);
+    assert!(plain.gap_before > 10.0, "{}", plain.summary);
+    let d = diagnose(&coulomb, Some(&reference));
+    assert_eq!(
+        d.answer.kind,
+        AnswerKind::Ambiguous,
+        "{}",
+        d.answer.statement
+    );
+    assert_eq!(names(&d), (vec![], vec![]), "{}", d.answer.statement);
+    let mut group = d.answer.ambiguous.concat();
+    group.sort();
+    assert_eq!(
+        group,
+        vec!["hip_coulomb_friction", "hip_viscous_damping"],
+        "{}",
+        d.answer.statement
+    );
+    let soft = trials_of(&robot, &[("soft_ground", 5e6)], 0.03, Some(12));
+    let d = diagnose(&soft, Some(&reference));
+    assert_eq!(names(&d), (vec![], vec![]), "{}", d.answer.statement);
+    let unchanged = trials_of(&robot, &[], 0.03, Some(13));
+    let null = diagnose(&unchanged, Some(&reference));
+    assert_eq!(
+        null.answer.kind,
+        AnswerKind::WithinNoise,
+        "{}",
+        null.answer.statement
+    );
+}
+
+/// The real binary: `gap diagnose --reference` with a reference of other conditions is
+/// refused (exit 2) by the trials file and line, naming the reference, before any fit.
+#[test]
+fn a_reference_of_other_conditions_is_refused_by_line() {
+    let out = survey(&[
+        "gap",
+        "diagnose",
+        "--trials",
+        "tests/golden/drake/gap-lagged/trials-hip_viscous_damping-0.02.csv",
+        "--reference",
+        "tests/data/gap/backlash-coulomb-3pct-seed0.csv",
+    ]);
+    assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
+    let e = stderr(&out);
+    assert!(
+        e.contains("trials-hip_viscous_damping-0.02.csv:2:")
+            && e.contains("L0.5x-f1.5")
+            && e.contains("no reference trial")
+            && e.contains("backlash-coulomb-3pct-seed0.csv"),
+        "{e}"
     );
 }
