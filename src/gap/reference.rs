@@ -91,13 +91,20 @@ pub fn carry(
             "the default relative sd must be finite and > 0".into(),
         ));
     }
-    if conditions.len() != set.trials.len() || nominal.len() != set.trials.len() {
+    if conditions.len() != set.trials.len()
+        || nominal.len() != set.trials.len()
+        || reference_conditions.len() != reference.trials.len()
+    {
         return Err(GapError::Invalid(format!(
-            "{}: {} trials but {} conditions and {} nominal walks",
+            "{}: {} trials but {} conditions and {} nominal walks; reference {}: {} trials but \
+             {} conditions",
             set.origin,
             set.trials.len(),
             conditions.len(),
-            nominal.len()
+            nominal.len(),
+            reference.origin,
+            reference.trials.len(),
+            reference_conditions.len()
         )));
     }
     let mut trials = Vec::with_capacity(set.trials.len());
