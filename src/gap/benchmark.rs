@@ -775,8 +775,8 @@ impl Planner<'_> {
     }
 }
 
-/// Drake's no-effect trials, the reference of `--drake-reference`.
-const DRAKE_NONE: &str = "trials-none.csv";
+/// Drake's no-effect trials (the file's stem), the reference of `--drake-reference`.
+const DRAKE_NONE: &str = "trials-none";
 
 /// The Drake cases: every `trials-*.csv` of `dir` (named `trials-<effect>-<value>` when
 /// Drake added an effect), `drake_seeds` noisy copies each. Returns the truths by file.
@@ -802,11 +802,11 @@ fn drake_cases(
     if opts.drake_reference
         && !files
             .iter()
-            .any(|f| f.file_name() == Some(DRAKE_NONE.as_ref()))
+            .any(|f| f.file_stem() == Some(DRAKE_NONE.as_ref()))
     {
         return Err(GapError::File {
             path: dir.display().to_string(),
-            message: format!("--drake-reference needs the no-effect trials {DRAKE_NONE} here"),
+            message: format!("--drake-reference needs the no-effect trials {DRAKE_NONE}.csv here"),
         });
     }
     for f in files {
@@ -919,11 +919,10 @@ fn run_case(
     // The reference: Drake's no-effect trials with noise of their own (another seed).
     let reference = match &case.truth {
         Truth::Drake { .. } if plan.drake_reference => {
-            let none = DRAKE_NONE.trim_end_matches(".csv");
             let (_, truth) = plan
                 .drake
-                .get(none)
-                .ok_or_else(|| GapError::Invalid(format!("no Drake trials {none}")))?;
+                .get(DRAKE_NONE)
+                .ok_or_else(|| GapError::Invalid(format!("no Drake trials {DRAKE_NONE}")))?;
             let key = format!("{}/reference", case.key);
             Some(TrialSet {
                 origin: key.clone(),

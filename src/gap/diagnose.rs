@@ -269,10 +269,7 @@ pub fn observations(set: &TrialSet, default_relative_sd: f64) -> (Vec<Observatio
                 min_torque += 1;
                 continue;
             }
-            let (sd, assumed) = match meas.sd {
-                Some(sd) => (sd, false),
-                None => ((default_relative_sd * meas.value.abs()).max(1e-12), true),
-            };
+            let (sd, assumed) = meas.sd_or(default_relative_sd);
             obs.push(Observation {
                 trial: i,
                 metric: m,

@@ -63,13 +63,6 @@ fn form_sd(change: f64, reference: f64, nominal: f64) -> f64 {
     (change * rho).abs()
 }
 
-/// A measurement's value and sd (the default relative sd where it states none).
-fn value_sd(m: Measurement, default_relative_sd: f64) -> (f64, f64) {
-    let sd =
-        m.sd.unwrap_or((default_relative_sd * m.value.abs()).max(1e-12));
-    (m.value, sd)
-}
-
 /// Carries `set` onto the nominal model through `reference`: every trial is paired with the
 /// reference trial of the same condition (an error names a trial without one), and each of
 /// its metrics becomes `nominal + (trial − reference)` with the two sds and the carrying's
@@ -138,8 +131,8 @@ pub fn carry(
                 dropped.push(format!("{} {}", t.name(), m.column()));
                 continue;
             };
-            let (tv, ts) = value_sd(tm, default_relative_sd);
-            let (rv, rs) = value_sd(rm, default_relative_sd);
+            let (tv, ts) = (tm.value, tm.sd_or(default_relative_sd).0);
+            let (rv, rs) = (rm.value, rm.sd_or(default_relative_sd).0);
             let change = tv - rv;
             out.measured[m.index()] = Some(Measurement {
                 value: nominal_value + change,

@@ -97,6 +97,17 @@ pub struct Measurement {
     pub sd: Option<f64>,
 }
 
+impl Measurement {
+    /// The stated sd, or `default_relative_sd` of the value where none is stated (never 0),
+    /// and whether it was assumed.
+    pub fn sd_or(&self, default_relative_sd: f64) -> (f64, bool) {
+        match self.sd {
+            Some(sd) => (sd, false),
+            None => ((default_relative_sd * self.value.abs()).max(1e-12), true),
+        }
+    }
+}
+
 /// One trial condition and what was measured there.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct Trial {
