@@ -68,5 +68,12 @@ same "$T/gz/gap-benchmark.svg" gap-benchmark-zippy/gap-benchmark.svg
 prefix "$T/gl/gap-benchmark.md" gap-benchmark-drake-lagged/gap-benchmark.md
 same "$T/gl/gap-benchmark.json" gap-benchmark-drake-lagged/gap-benchmark.json
 same "$T/gl/gap-benchmark.svg" gap-benchmark-drake-lagged/gap-benchmark.svg
+"$S" gap benchmark --design mugatu --quick --noise 0.03,0.05 --null-cases 300 --one-robot-nulls 100 \
+  --drake tests/golden/drake/gap-lagged-next --drake-seeds 3 --drake-reference \
+  --merge reports/gap-benchmark-drake-lagged-next.points.csv \
+  --points "$T/gn.points.csv" --out "$T/gn" >/dev/null 2>&1
+prefix "$T/gn/gap-benchmark.md" gap-benchmark-drake-lagged-next/gap-benchmark.md
+same "$T/gn/gap-benchmark.json" gap-benchmark-drake-lagged-next/gap-benchmark.json
+same "$T/gn/gap-benchmark.svg" gap-benchmark-drake-lagged-next/gap-benchmark.svg
 echo "$fails report(s) differ"
 [ "$fails" -eq 0 ]

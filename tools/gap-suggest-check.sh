@@ -5,6 +5,7 @@
 # the design's own drives (0.97, 1, 1.03×); both sets separated on the summaries alone.
 # Run from the repository root after `cargo build --release`: tools/gap-suggest-check.sh [seeds]
 # Another truth: EFFECT=soft_ground M=1e8 RIVAL=hip_backlash tools/gap-suggest-check.sh 10
+# Suggestions off the forward gait too: SUGGEST_ARGS=--any-gait tools/gap-suggest-check.sh 10
 set -euo pipefail
 S="$(pwd)/${SURVEY:-target/release/survey}"
 E="${EFFECT:-hip_coulomb_friction}"
@@ -27,7 +28,8 @@ verdict() {
 }
 for seed in $(seq 1 "$N"); do
   "$S" gap synth --conditions conditions-6.csv --effect "$E=$M" --noise 0.03 --seed "$seed" --out base.csv 2>/dev/null
-  "$S" gap suggest --trials base.csv --candidates "$E,$RIVAL" --budget 3 --out next.csv >/dev/null 2>&1
+  # shellcheck disable=SC2086 # SUGGEST_ARGS: extra flags, word-split on purpose
+  "$S" gap suggest --trials base.csv --candidates "$E,$RIVAL" --budget 3 ${SUGGEST_ARGS:-} --out next.csv >/dev/null 2>&1
   "$S" gap synth --conditions next.csv --effect "$E=$M" --noise 0.03 --seed $((seed + 1000)) --out nextm.csv 2>/dev/null
   "$S" gap synth --conditions default3.csv --effect "$E=$M" --noise 0.03 --seed $((seed + 1000)) --out defm.csv 2>/dev/null
   (cat base.csv; tail -n +2 nextm.csv) > withnext.csv

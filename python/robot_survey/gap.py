@@ -284,6 +284,7 @@ def diagnose(
     default_sd: float = 0.10,
     alpha: float = 0.001,
     calibrate: bool = True,
+    reference: Optional[TrialsArg] = None,
 ) -> Diagnosis:
     """Diagnoses trials against the simulator (``survey gap diagnose``); runs with the GIL
     released.
@@ -305,8 +306,14 @@ def diagnose(
     calibrate:
         Calibrate the designs' ``[[uncertain]]`` parameters (False: only effects are
         candidates).
+    reference:
+        Trials of the same conditions without the change (``survey gap diagnose
+        --reference``): a path or a DataFrame. Each metric is then carried onto the model as
+        nominal + (trial − reference), so a discrepancy the model has everywhere (another
+        engine, an unmodelled property of the robot) is not blamed on an effect.
     """
     a = _trials_args(trials)
+    r = _trials_args(reference) if reference is not None else None
     text, timing = _core.gap_diagnose_json(
         a["path"],
         a["text"],
@@ -317,5 +324,8 @@ def diagnose(
         float(default_sd),
         float(alpha),
         calibrate,
+        r["path"] if r else None,
+        r["text"] if r else None,
+        (r["origin"] or "<DataFrame>") if r else "<DataFrame>",
     )
     return Diagnosis(json.loads(text), json.loads(timing))

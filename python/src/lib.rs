@@ -602,8 +602,10 @@ fn gap_synth_csv(
 }
 
 /// `survey gap diagnose --format json`, and the wall-clock timing (not part of the result).
+/// `reference_*`: the reference trials (`survey gap diagnose --reference`), as path or text
+/// like the trials.
 #[pyfunction]
-#[pyo3(signature = (path=None, text=None, origin="<DataFrame>", base_dir=None, effects=Vec::new(), grid=9, default_sd=0.10, alpha=0.001, calibrate=true))]
+#[pyo3(signature = (path=None, text=None, origin="<DataFrame>", base_dir=None, effects=Vec::new(), grid=9, default_sd=0.10, alpha=0.001, calibrate=true, reference_path=None, reference_text=None, reference_origin="<DataFrame>"))]
 #[allow(clippy::too_many_arguments)]
 fn gap_diagnose_json(
     py: Python<'_>,
@@ -616,22 +618,32 @@ fn gap_diagnose_json(
     default_sd: f64,
     alpha: f64,
     calibrate: bool,
+    reference_path: Option<PathBuf>,
+    reference_text: Option<String>,
+    reference_origin: &str,
 ) -> PyResult<(String, String)> {
     let origin = origin.to_string();
+    let reference_origin = reference_origin.to_string();
     detached(py, || {
         let lib = EffectLibrary::bundled()?;
-        let set = trials_of(
-            path.as_deref(),
-            text.as_deref(),
-            &origin,
-            base_dir.as_deref().unwrap_or(Path::new(".")),
-        )?;
+        let base = base_dir.as_deref().unwrap_or(Path::new("."));
+        let set = trials_of(path.as_deref(), text.as_deref(), &origin, base)?;
+        let reference = match (&reference_path, &reference_text) {
+            (None, None) => None,
+            (p, t) => Some(trials_of(
+                p.as_deref(),
+                t.as_deref(),
+                &reference_origin,
+                base,
+            )?),
+        };
         let opts = DiagnoseOptions {
             effects,
             grid_points: grid,
             default_relative_sd: default_sd,
             alpha,
             calibrate,
+            reference,
             ..DiagnoseOptions::default()
         };
         let (d, timing) = gap::diagnose(&set, &lib, &opts, &Silent)?;

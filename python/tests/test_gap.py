@@ -124,3 +124,22 @@ def test_bad_trials_name_line_and_column(cli, trials_file, tmp_path):
     assert str(e.value) == msg and ":4:3: leg_length_m" in msg
     with pytest.raises(TypeError):
         gap.diagnose(42)
+
+
+def test_diagnose_through_a_reference_equals_the_clis_json(cli, trials_file, tmp_path):
+    """`reference=` is `--reference`; trials taken as their own reference change nothing,
+    so every metric is carried onto the nominal itself and the answer is within noise."""
+    _, small = trials_file
+    ref = tmp_path / "ref.csv"
+    cli.run("gap", "synth", "--conditions", str(small), "--noise", "0.05", "--seed", "2",
+            "--out", str(ref))
+    got = gap.diagnose(small, reference=ref, **DIAG)
+    want = cli.json("gap", "diagnose", "--trials", str(small), "--reference", str(ref),
+                    *DIAG_FLAGS, "--format", "json")
+    assert got.to_dict() == want
+    same = gap.diagnose(small, reference=gap.read_trials(small.read_text(encoding="utf-8")),
+                        **DIAG)
+    assert same.answer["kind"] == "within_noise", same.statement
+    other = gap.read_trials(small.read_text(encoding="utf-8")).head(3)
+    with pytest.raises(rs.SurveyError, match="reference"):
+        gap.diagnose(small, reference=other, **DIAG)

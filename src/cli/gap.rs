@@ -376,7 +376,9 @@ survey gap suggest --trials t.csv --candidates hip_coulomb_friction,hip_viscous_
 The candidates are fitted to the trials (as `survey gap separate`); the two leading ones are \
 walked on every condition of the pool (drive frequency 0.85-1.15x the design's, servo amplitude \
 0.8-1.2x, payload 0-30 %, slope -2..2 deg, at the robot's own size); a condition is offered only \
-where the nominal and both candidates walk. The score is the expected likelihood-ratio statistic \
+where the nominal and both candidates walk forward (no fall, steady speed above the design's \
+walking threshold: where a model scuffs in place, another engine or the robot parts from it most) \
+and their gaits are smooth. The score is the expected likelihood-ratio statistic \
 between the two on that trial: summaries at the trials' median relative sd, plus the cycles when \
 the trials have logs.")]
 pub struct SuggestArgs {
@@ -395,6 +397,11 @@ pub struct SuggestArgs {
     /// Relative sd assumed for the new trials when the trials state none.
     #[arg(long, default_value_t = 0.05)]
     pub default_sd: f64,
+    /// Also offer conditions where a model stands, scuffs or walks backward (only falls
+    /// excluded). They separate look-alikes best in the simulator's own world, but there the
+    /// robot (or another engine) parts from the model most: off by default.
+    #[arg(long)]
+    pub any_gait: bool,
     /// Write the suggested conditions as a trials CSV to fill in.
     #[arg(long, value_name = "FILE")]
     pub out: Option<PathBuf>,
@@ -694,11 +701,17 @@ fn suggest(a: &SuggestArgs) -> anyhow::Result<ExitCode> {
             ..Default::default()
         },
         default_relative_sd: a.default_sd,
+        any_gait: a.any_gait,
     };
     let pb = spinner("fitting the candidates, then walking the pool");
     let s = gap::suggest::suggest(&set, &lib, &opts, &pb)?;
     pb.clear();
-    if let Some(p) = &a.out {
+    if let (Some(p), true) = (&a.out, s.suggested.is_empty()) {
+        eprintln!(
+            "nothing written to {}: no condition of the pool qualifies (see below)",
+            p.display()
+        );
+    } else if let Some(p) = &a.out {
         let next = TrialSet {
             origin: p.display().to_string(),
             base_dir: PathBuf::from("."),

@@ -6,7 +6,9 @@
 //! The pool is a grid over what a lab can change on one robot without rebuilding it: drive
 //! frequency, servo amplitude (position-servo designs), payload and ground slope, within
 //! [`POOL`]'s ranges; a condition is offered only where the nominal model and both leading
-//! explanations walk (a trial that falls measures nothing, and risks the robot).
+//! explanations walk forward (a trial that falls measures nothing, and risks the robot; one
+//! that scuffs in place is on a gait where another engine, or the robot, parts from the
+//! model most: Drake-Lagged at such conditions, `tests/golden/drake/gap-lagged-next/`).
 
 use rayon::prelude::*;
 use serde::Serialize;
@@ -23,6 +25,7 @@ use super::trials::{Metric, Trial, TrialSet};
 use super::waveform;
 use crate::progress::Observer;
 use crate::sim::design::ControlSpec;
+use crate::sim::model::GRAVITY_MPS2;
 
 /// The pool's levels: drive frequency (× the design's at the robot's size), servo amplitude
 /// (× the design's), payload (fraction of the robot's mass added) and slope [deg, downhill
@@ -49,13 +52,6 @@ const SMOOTHNESS_STEP: f64 = 0.02;
 /// beyond it the gait changes character within the candidate's own uncertainty.
 const SMOOTHNESS_Z: f64 = 2.0;
 
-fn fell_count(walks: &[[SimCycle; 3]]) -> usize {
-    walks
-        .iter()
-        .filter(|w| w.iter().any(|x| x.metrics.fell))
-        .count()
-}
-
 /// Largest expected z² one metric (or one signal's cycle) of one trial may contribute: a
 /// 5-sd difference already decides; beyond it the two models walk qualitatively different
 /// gaits there (a bifurcation), where the simulator's own resolution is least trusted, so a
@@ -69,6 +65,11 @@ pub struct SuggestOptions {
     /// Relative sd assumed for the new trials' summaries (the median of the trials' own when
     /// they state sds).
     pub default_relative_sd: f64,
+    /// Also offer conditions where a model stands, scuffs or walks backward (not falls). In
+    /// the simulator's own world they separate look-alikes best (hip Coulomb friction vs
+    /// damping: 10/10 named with them, 5/10 without); on another engine they made an answer
+    /// worse (`tests/golden/drake/gap-lagged-next/README.md`).
+    pub any_gait: bool,
 }
 
 /// A condition to run next.
@@ -94,10 +95,16 @@ pub struct Suggestion {
     /// The two leading explanations and their fitted values (SI).
     pub leading: Vec<(String, f64)>,
     pub budget: usize,
-    /// Pool conditions tried, and those offered: all three models walk and the leaders'
-    /// gaits are smooth there.
+    /// Pool conditions tried, and those offered: all three models walk forward and the
+    /// leaders' gaits are smooth there.
     pub pool: usize,
     pub walkable: usize,
+    /// Conditions left out because a model, without falling, does not walk forward there
+    /// (steady speed at or below the design's walking threshold: it stands, scuffs or walks
+    /// backward).
+    pub not_forward: usize,
+    /// Whether conditions off the forward gait were offered too ([`SuggestOptions::any_gait`]).
+    pub any_gait: bool,
     /// Conditions left out because a leader's metrics bend sharply there (or a step falls).
     pub knife_edge: usize,
     pub relative_sd: f64,
@@ -171,22 +178,40 @@ pub fn suggest(
             Ok(r)
         })
         .collect::<Result<_, GapError>>()?;
+    let forward: Vec<bool> = pool
+        .iter()
+        .zip(&walks)
+        .map(|(c, w)| {
+            if opts.any_gait {
+                !w.iter().any(|x| x.metrics.fell)
+            } else {
+                walks_forward(c, w)
+            }
+        })
+        .collect();
     let smooth: Vec<bool> = pool
         .par_iter()
         .zip(&walks)
-        .map(|(c, w)| {
-            let ok = is_smooth(c, w, lib, &settings, settle, relative_sd)?;
+        .zip(&forward)
+        .map(|((c, w), &f)| {
+            let ok = f && is_smooth(c, w, lib, &settings, settle, relative_sd)?;
             if ok {
                 progress.tick();
             }
             Ok(ok)
         })
         .collect::<Result<_, GapError>>()?;
-    let knife_edge = walks
+    let not_forward = walks
+        .iter()
+        .zip(&forward)
+        .filter(|(w, f)| !**f && !w.iter().any(|x| x.metrics.fell))
+        .count();
+    let knife_edge = forward
         .iter()
         .zip(&smooth)
-        .filter(|(w, ok)| !**ok && !w.iter().any(|x| x.metrics.fell))
+        .filter(|(f, ok)| **f && !**ok)
         .count();
+    let forward_count = forward.iter().filter(|f| **f).count();
     let floor = opts.separate.relative_floor;
     let score = |c: &Condition, w: &[SimCycle; 3]| score_condition(c, w, relative_sd, floor);
     let mut scored: Vec<Suggested> = pool
@@ -220,12 +245,26 @@ pub fn suggest(
         budget: opts.budget,
         pool: pool.len(),
         walkable,
+        not_forward,
+        any_gait: opts.any_gait,
         knife_edge,
         relative_sd,
         suggested: scored,
         default_condition,
-        walks: sep.walks + 3 * pool.len() + 4 * (pool.len() - fell_count(&walks)),
+        walks: sep.walks + 3 * pool.len() + 4 * forward_count,
     })
+}
+
+/// Whether the nominal and both leaders walk forward at `c`: no fall and a steady speed
+/// above the design's walking threshold, the criterion of `WalkReport::walks`.
+fn walks_forward(c: &Condition, w: &[SimCycle; 3]) -> bool {
+    let Ok(d) = c.scaled_design() else {
+        return false;
+    };
+    let threshold_mps =
+        d.criteria.walk_speed_threshold_over_sqrt_gl * (GRAVITY_MPS2 * c.leg_length_m).sqrt();
+    w.iter()
+        .all(|x| !x.metrics.fell && x.metrics.get(Metric::VelocityMps) > threshold_mps)
 }
 
 /// Smoothness: each leader a step below and above its fitted value; a condition where

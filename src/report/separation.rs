@@ -339,12 +339,21 @@ pub fn suggestion_md(s: &Suggestion) -> String {
         .iter()
         .map(|(k, v)| format!("{k} = {}", sig(*v)))
         .collect();
+    let gait = if s.any_gait {
+        "none falls (any gait: --any-gait)".to_string()
+    } else {
+        format!(
+            "the nominal and both walk forward ({} more where one stands, scuffs or walks \
+             backward)",
+            s.not_forward
+        )
+    };
     let _ = writeln!(
         o,
         "Leading explanations (fitted to the trials): {}. Pool: {} conditions of {} at the robot's \
-         size, {} where the nominal and both walk, of which {} left out as knife-edge (a leader's \
-         metrics bend by more than 2 sd within ±2 % of its range); summaries scored at {} % \
-         relative sd. {} walks.\n",
+         size, {} where {gait}, of which {} left out as knife-edge (a leader's metrics bend by \
+         more than 2 sd within ±2 % of its range); summaries scored at {} % relative sd. {} \
+         walks.\n",
         lead.join(" vs "),
         s.pool,
         s.design,
@@ -353,6 +362,15 @@ pub fn suggestion_md(s: &Suggestion) -> String {
         sig(100.0 * s.relative_sd),
         s.walks
     );
+    if s.suggested.is_empty() {
+        let _ = writeln!(
+            o,
+            "No condition of the pool qualifies: in every one a model falls, does not walk \
+             forward, or walks on a knife edge. Nothing to suggest at this size; the trials \
+             themselves, or logs (`survey gap separate`), are what can tell the two apart.\n"
+        );
+        return o;
+    }
     let _ = writeln!(
         o,
         "| trial | leg length [m] | drive [Hz] | amplitude [deg] | mass [kg] | slope [deg] | expected LR, summaries | expected LR, cycles |"

@@ -190,8 +190,8 @@ fn a_bad_robot_log_names_its_line_and_column() {
 
 /// `survey gap suggest`: every suggested condition lies in the pool's ranges (drive
 /// 0.85–1.15× the design's at the robot's size, amplitude 0.8–1.2×, payload 0–30 %, slope
-/// ±2°) at the robot's own leg length, the first separates the two candidates better than
-/// the design's own drive, and two runs print the same bytes.
+/// ±2°) at the robot's own leg length, the nominal walks forward there, the first separates
+/// the two candidates better than the design's own drive, and two runs print the same bytes.
 #[test]
 fn suggest_stays_in_range_beats_the_default_and_is_deterministic() {
     let dir = scratch();
@@ -242,6 +242,74 @@ fn suggest_stays_in_range_beats_the_default_and_is_deterministic() {
     );
     let csv = std::fs::read_to_string(&next).expect("next.csv");
     assert!(csv.lines().count() == 4 && csv.contains("next-1,mugatu-two-uncertain.toml,0.153"));
+    // The nominal model walks forward on every suggestion: walked again by `gap synth`
+    // (noise-free), its speed beats the design's criterion 0.1·√(gL) = 0.1225 m/s at 0.153 m.
+    let walked = dir.path().join("walked.csv");
+    let o = survey(&[
+        "gap",
+        "synth",
+        "--conditions",
+        next.to_str().expect("utf-8"),
+        "--noise",
+        "0",
+        "--out",
+        walked.to_str().expect("utf-8"),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let mut r = csv::ReaderBuilder::new()
+        .comment(Some(b'#'))
+        .from_path(&walked)
+        .expect("walked.csv");
+    let col = r
+        .headers()
+        .expect("header")
+        .iter()
+        .position(|h| h == "velocity_mps")
+        .expect("velocity column");
+    let speeds: Vec<f64> = r
+        .records()
+        .map(|x| x.expect("row")[col].parse().expect("speed"))
+        .collect();
+    assert_eq!(speeds.len(), 3);
+    assert!(speeds.iter().all(|v| *v > 0.1225), "{speeds:?}");
+}
+
+/// Where no model walks forward there is nothing to suggest: with the test design's walking
+/// threshold raised to 5·√(gL) (a Froude number of 25, beyond any walker) after the trials
+/// were made, `suggest` says so, succeeds, and writes no file.
+#[test]
+fn suggest_offers_nothing_where_no_model_walks_forward() {
+    let dir = scratch();
+    let trials = synth(dir.path(), "s", &["hip_coulomb_friction=0.006"], 3);
+    let design = dir.path().join("mugatu-two-uncertain.toml");
+    let text = std::fs::read_to_string(&design).expect("design");
+    let raised = text.replace(
+        "walk_speed_threshold_over_sqrt_gl = 0.1 ",
+        "walk_speed_threshold_over_sqrt_gl = 5.0 ",
+    );
+    assert_ne!(raised, text);
+    std::fs::write(&design, raised).expect("write design");
+    let next = dir.path().join("next.csv");
+    let o = survey(&[
+        "gap",
+        "suggest",
+        "--trials",
+        &trials,
+        "--candidates",
+        "hip_coulomb_friction,hip_viscous_damping",
+        "--budget",
+        "3",
+        "--out",
+        next.to_str().expect("utf-8"),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let out = stdout(&o);
+    assert!(
+        out.contains("0 where the nominal and both walk forward")
+            && out.contains("No condition of the pool qualifies"),
+        "{out}"
+    );
+    assert!(!next.exists() && stderr(&o).contains("nothing written"));
 }
 
 /// The documented example (`dataset/trials/example-logs.csv`, dataset/trials/README.md):
