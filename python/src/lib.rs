@@ -556,6 +556,20 @@ fn trials_of(
     })
 }
 
+/// Trials given as a path or a text, or none ([`trials_of`] when either is given): the
+/// optional conditions of `gap_synth_csv` and reference of `gap_diagnose_json`.
+fn optional_trials_of(
+    path: Option<&Path>,
+    text: Option<&str>,
+    origin: &str,
+    base_dir: &Path,
+) -> Res<Option<TrialSet>> {
+    if path.is_none() && text.is_none() {
+        return Ok(None);
+    }
+    trials_of(path, text, origin, base_dir).map(Some)
+}
+
 /// `survey gap synth`: the trials CSV it writes (default conditions, or those of a trials
 /// file/text), with effects (`NAME=VALUE`), wrong parameters (`PATH=VALUE`) and noise.
 #[pyfunction]
@@ -587,15 +601,12 @@ fn gap_synth_csv(
             noise,
             seed,
         )?;
-        let conditions = match (&conditions_path, &conditions_text) {
-            (None, None) => None,
-            (p, t) => Some(trials_of(
-                p.as_deref(),
-                t.as_deref(),
-                &origin,
-                base_dir.as_deref().unwrap_or(Path::new(".")),
-            )?),
-        };
+        let conditions = optional_trials_of(
+            conditions_path.as_deref(),
+            conditions_text.as_deref(),
+            &origin,
+            base_dir.as_deref().unwrap_or(Path::new(".")),
+        )?;
         let out = gap::synth::synthesize(&lib, &opts, conditions, &command, &Silent)?;
         Ok(out.to_csv()?)
     })
@@ -628,15 +639,12 @@ fn gap_diagnose_json(
         let lib = EffectLibrary::bundled()?;
         let base = base_dir.as_deref().unwrap_or(Path::new("."));
         let set = trials_of(path.as_deref(), text.as_deref(), &origin, base)?;
-        let reference = match (&reference_path, &reference_text) {
-            (None, None) => None,
-            (p, t) => Some(trials_of(
-                p.as_deref(),
-                t.as_deref(),
-                &reference_origin,
-                base,
-            )?),
-        };
+        let reference = optional_trials_of(
+            reference_path.as_deref(),
+            reference_text.as_deref(),
+            &reference_origin,
+            base,
+        )?;
         let opts = DiagnoseOptions {
             effects,
             grid_points: grid,

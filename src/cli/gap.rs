@@ -706,7 +706,9 @@ fn suggest(a: &SuggestArgs) -> anyhow::Result<ExitCode> {
     let pb = spinner("fitting the candidates, then walking the pool");
     let s = gap::suggest::suggest(&set, &lib, &opts, &pb)?;
     pb.clear();
-    if let (Some(p), true) = (&a.out, s.suggested.is_empty()) {
+    if let Some(p) = &a.out
+        && s.suggested.is_empty()
+    {
         eprintln!(
             "nothing written to {}: no condition of the pool qualifies (see below)",
             p.display()

@@ -25,7 +25,6 @@ use super::trials::{Metric, Trial, TrialSet};
 use super::waveform;
 use crate::progress::Observer;
 use crate::sim::design::ControlSpec;
-use crate::sim::model::GRAVITY_MPS2;
 
 /// The pool's levels: drive frequency (× the design's at the robot's size), servo amplitude
 /// (× the design's), payload (fraction of the robot's mass added) and slope [deg, downhill
@@ -178,16 +177,15 @@ pub fn suggest(
             Ok(r)
         })
         .collect::<Result<_, GapError>>()?;
+    let fell: Vec<bool> = walks
+        .iter()
+        .map(|w| w.iter().any(|x| x.metrics.fell))
+        .collect();
     let forward: Vec<bool> = pool
         .iter()
         .zip(&walks)
-        .map(|(c, w)| {
-            if opts.any_gait {
-                !w.iter().any(|x| x.metrics.fell)
-            } else {
-                walks_forward(c, w)
-            }
-        })
+        .zip(&fell)
+        .map(|((c, w), &fell)| !fell && (opts.any_gait || walks_forward(c, w)))
         .collect();
     let smooth: Vec<bool> = pool
         .par_iter()
@@ -201,10 +199,10 @@ pub fn suggest(
             Ok(ok)
         })
         .collect::<Result<_, GapError>>()?;
-    let not_forward = walks
+    let not_forward = fell
         .iter()
         .zip(&forward)
-        .filter(|(w, f)| !**f && !w.iter().any(|x| x.metrics.fell))
+        .filter(|(fell, f)| !**fell && !**f)
         .count();
     let knife_edge = forward
         .iter()
@@ -256,13 +254,10 @@ pub fn suggest(
 }
 
 /// Whether the nominal and both leaders walk forward at `c`: no fall and a steady speed
-/// above the design's walking threshold, the criterion of `WalkReport::walks`.
+/// above the design's walking threshold, the criterion of `WalkReport::walks` (the
+/// criteria are dimensionless: the unscaled design's serve at every size).
 fn walks_forward(c: &Condition, w: &[SimCycle; 3]) -> bool {
-    let Ok(d) = c.scaled_design() else {
-        return false;
-    };
-    let threshold_mps =
-        d.criteria.walk_speed_threshold_over_sqrt_gl * (GRAVITY_MPS2 * c.leg_length_m).sqrt();
+    let threshold_mps = c.design.criteria.walk_speed_threshold_mps(c.leg_length_m);
     w.iter()
         .all(|x| !x.metrics.fell && x.metrics.get(Metric::VelocityMps) > threshold_mps)
 }

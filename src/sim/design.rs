@@ -158,6 +158,14 @@ pub struct CriteriaSpec {
     pub fall_pitch_deg: f64,
 }
 
+impl CriteriaSpec {
+    /// The steady forward speed above which a walker of leg length `leg_length_m` walks
+    /// [m/s]: the threshold × √(gL). Dimensionless, so the same at every size.
+    pub fn walk_speed_threshold_mps(&self, leg_length_m: f64) -> f64 {
+        self.walk_speed_threshold_over_sqrt_gl * (GRAVITY_MPS2 * leg_length_m).sqrt()
+    }
+}
+
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize, Default)]
 #[serde(deny_unknown_fields)]
 pub struct GroundSpec {

@@ -712,8 +712,7 @@ fn analyze(
         .iter()
         .map(|s| s.peak_abs_torque_nm)
         .fold(0.0, f64::max);
-    r.walks =
-        r.velocity_mps > d.criteria.walk_speed_threshold_over_sqrt_gl * (GRAVITY_MPS2 * l).sqrt();
+    r.walks = r.velocity_mps > d.criteria.walk_speed_threshold_mps(l);
     r
 }
 

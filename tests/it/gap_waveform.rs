@@ -4,6 +4,9 @@
 //! named by neither; robot logs with only the columns a robot records; clear errors.
 
 use std::path::Path;
+use std::process::Output;
+
+use robot_survey::gap::trials::{Metric, TrialSet};
 
 use super::common::{repo, stderr, stdout, survey};
 
@@ -44,6 +47,25 @@ fn synth(dir: &Path, name: &str, truth: &[&str], seed: u64) -> String {
     let o = survey(&args);
     assert!(o.status.success(), "{}", stderr(&o));
     out.to_str().expect("utf-8").to_string()
+}
+
+/// `survey gap suggest` between hip Coulomb friction and viscous damping on `trials`, three
+/// trials, written to `next`; `extra` arguments after those.
+fn suggest(trials: &str, next: &Path, extra: &[&str]) -> Output {
+    let mut args = vec![
+        "gap",
+        "suggest",
+        "--trials",
+        trials,
+        "--candidates",
+        "hip_coulomb_friction,hip_viscous_damping",
+        "--budget",
+        "3",
+        "--out",
+        next.to_str().expect("utf-8"),
+    ];
+    args.extend_from_slice(extra);
+    survey(&args)
 }
 
 /// The verdict kinds of `survey gap separate --format json`: (summaries, with waveforms),
@@ -198,20 +220,7 @@ fn suggest_stays_in_range_beats_the_default_and_is_deterministic() {
     let trials = synth(dir.path(), "s", &["hip_coulomb_friction=0.006"], 3);
     let next = dir.path().join("next.csv");
     let run = || {
-        let o = survey(&[
-            "gap",
-            "suggest",
-            "--trials",
-            &trials,
-            "--candidates",
-            "hip_coulomb_friction,hip_viscous_damping",
-            "--budget",
-            "3",
-            "--format",
-            "json",
-            "--out",
-            next.to_str().expect("utf-8"),
-        ]);
+        let o = suggest(&trials, &next, &["--format", "json"]);
         assert!(o.status.success(), "{}", stderr(&o));
         stdout(&o)
     };
@@ -256,19 +265,11 @@ fn suggest_stays_in_range_beats_the_default_and_is_deterministic() {
         walked.to_str().expect("utf-8"),
     ]);
     assert!(o.status.success(), "{}", stderr(&o));
-    let mut r = csv::ReaderBuilder::new()
-        .comment(Some(b'#'))
-        .from_path(&walked)
-        .expect("walked.csv");
-    let col = r
-        .headers()
-        .expect("header")
+    let speeds: Vec<f64> = TrialSet::read(&walked)
+        .expect("walked.csv")
+        .trials
         .iter()
-        .position(|h| h == "velocity_mps")
-        .expect("velocity column");
-    let speeds: Vec<f64> = r
-        .records()
-        .map(|x| x.expect("row")[col].parse().expect("speed"))
+        .map(|t| t.measured(Metric::VelocityMps).expect("speed").value)
         .collect();
     assert_eq!(speeds.len(), 3);
     assert!(speeds.iter().all(|v| *v > 0.1225), "{speeds:?}");
@@ -290,18 +291,7 @@ fn suggest_offers_nothing_where_no_model_walks_forward() {
     assert_ne!(raised, text);
     std::fs::write(&design, raised).expect("write design");
     let next = dir.path().join("next.csv");
-    let o = survey(&[
-        "gap",
-        "suggest",
-        "--trials",
-        &trials,
-        "--candidates",
-        "hip_coulomb_friction,hip_viscous_damping",
-        "--budget",
-        "3",
-        "--out",
-        next.to_str().expect("utf-8"),
-    ]);
+    let o = suggest(&trials, &next, &[]);
     assert!(o.status.success(), "{}", stderr(&o));
     let out = stdout(&o);
     assert!(
