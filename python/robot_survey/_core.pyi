@@ -109,6 +109,10 @@ def gap_diagnose_json(
     default_sd: float = 0.10,
     alpha: float = 0.001,
     calibrate: bool = True,
+    reference_path: Optional[str] = None,
+    reference_text: Optional[str] = None,
+    reference_origin: str = "<DataFrame>",
+    audit_undeclared: bool = True,
 ) -> Tuple[str, str]: ...
 def trial_columns() -> List[str]: ...
 def builtin_designs() -> List[str]: ...

@@ -285,6 +285,7 @@ def diagnose(
     alpha: float = 0.001,
     calibrate: bool = True,
     reference: Optional[TrialsArg] = None,
+    audit_undeclared: bool = True,
 ) -> Diagnosis:
     """Diagnoses trials against the simulator (``survey gap diagnose``); runs with the GIL
     released.
@@ -311,6 +312,10 @@ def diagnose(
         --reference``): a path or a DataFrame. Each metric is then carried onto the model as
         nominal + (trial − reference), so a discrepancy the model has everywhere (another
         engine, an unmodelled property of the robot) is not blamed on an effect.
+    audit_undeclared:
+        Weigh each named knob against the design's undeclared numbers (False is
+        ``--no-audit-undeclared``): one that an undeclared number fits as well is not named
+        but listed with it as "not told apart".
     """
     a = _trials_args(trials)
     r = _trials_args(reference) if reference is not None else None
@@ -327,5 +332,6 @@ def diagnose(
         r["path"] if r else None,
         r["text"] if r else None,
         (r["origin"] or "<DataFrame>") if r else "<DataFrame>",
+        bool(audit_undeclared),
     )
     return Diagnosis(json.loads(text), json.loads(timing))

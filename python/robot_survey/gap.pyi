@@ -103,4 +103,6 @@ def diagnose(
     default_sd: float = 0.10,
     alpha: float = 0.001,
     calibrate: bool = True,
+    reference: Optional[_Trials] = None,
+    audit_undeclared: bool = True,
 ) -> Diagnosis: ...

@@ -614,9 +614,9 @@ fn gap_synth_csv(
 
 /// `survey gap diagnose --format json`, and the wall-clock timing (not part of the result).
 /// `reference_*`: the reference trials (`survey gap diagnose --reference`), as path or text
-/// like the trials.
+/// like the trials; `audit_undeclared` false is `--no-audit-undeclared`.
 #[pyfunction]
-#[pyo3(signature = (path=None, text=None, origin="<DataFrame>", base_dir=None, effects=Vec::new(), grid=9, default_sd=0.10, alpha=0.001, calibrate=true, reference_path=None, reference_text=None, reference_origin="<DataFrame>"))]
+#[pyo3(signature = (path=None, text=None, origin="<DataFrame>", base_dir=None, effects=Vec::new(), grid=9, default_sd=0.10, alpha=0.001, calibrate=true, reference_path=None, reference_text=None, reference_origin="<DataFrame>", audit_undeclared=true))]
 #[allow(clippy::too_many_arguments)]
 fn gap_diagnose_json(
     py: Python<'_>,
@@ -632,6 +632,7 @@ fn gap_diagnose_json(
     reference_path: Option<PathBuf>,
     reference_text: Option<String>,
     reference_origin: &str,
+    audit_undeclared: bool,
 ) -> PyResult<(String, String)> {
     let origin = origin.to_string();
     let reference_origin = reference_origin.to_string();
@@ -652,6 +653,7 @@ fn gap_diagnose_json(
             alpha,
             calibrate,
             reference,
+            audit_undeclared,
             ..DiagnoseOptions::default()
         };
         let (d, timing) = gap::diagnose(&set, &lib, &opts, &Silent)?;

@@ -80,6 +80,17 @@ def test_diagnose_equals_the_clis_json(cli, trials_file, diagnosis):
     assert diagnosis.to_dict() == want
 
 
+def test_diagnose_without_the_audit_equals_the_clis(cli, trials_file, diagnosis):
+    """``audit_undeclared=False`` is ``--no-audit-undeclared``; the default audits."""
+    _, small = trials_file
+    got = gap.diagnose(small, audit_undeclared=False, **DIAG).to_dict()
+    want = cli.json("gap", "diagnose", "--trials", str(small), *DIAG_FLAGS,
+                    "--no-audit-undeclared", "--format", "json")
+    assert got == want
+    assert not any(n.startswith("undeclared-parameter audit") for n in got["notes"])
+    assert any(n.startswith("undeclared-parameter audit") for n in diagnosis.to_dict()["notes"])
+
+
 def test_diagnose_names_the_effect_that_made_the_trials(diagnosis):
     """The trials were made with hip viscous damping 0.01 N·m·s/rad: the answer names it,
     with an interval that holds the truth, and the gap shrinks on held-out conditions."""
