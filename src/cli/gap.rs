@@ -246,7 +246,8 @@ pub struct SelectionArgs {
     /// around the file's value, or the design's [audit] table): a named knob that an
     /// undeclared number, in its place, fits as well (within the identification distance)
     /// is not named — the answer says "not told apart from the undeclared …". It runs only
-    /// when something is named (1.2–2.2× the walks) and only takes names away. On truths
+    /// when the chain holds a knob (the answer's names, or a partly explained answer's
+    /// leads; 1.2–2.2× the walks) and only takes names away. On truths
     /// held out from every rule it turned both stand-ins named without it (COM height for
     /// the leg's roll inertia, μ for the stiction speed) into groups holding the truth; on
     /// the benchmark it unnamed 2 stand-ins and 5 right names whose look-alike is a real
