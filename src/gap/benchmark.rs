@@ -327,8 +327,10 @@ pub fn thresholds(
         calibrate,
         explanations: false,
         identifiability: true,
-        // The thresholds do not depend on the selection; its plain rules are the quickest.
+        // The thresholds depend neither on the selection (its plain rules are the quickest)
+        // nor on the audit of its answer.
         select: SelectOptions::plain(),
+        audit_undeclared: false,
         ..DiagnoseOptions::default()
     };
     Ok(
