@@ -243,7 +243,8 @@ pub struct SelectionArgs {
     pub audit_undeclared: bool,
     /// `gap diagnose`: without the undeclared-parameter audit. The audit weighs the answer
     /// against every number of the design file it does not declare [[uncertain]] (×/÷ 2
-    /// around the file's value, or the design's [audit] table): a named knob that an
+    /// around the file's value, or the design's [audit] table; a number whose fit stops at
+    /// an end is weighed again up to ×/÷ 8): a named knob that an
     /// undeclared number, in its place, fits as well (within the identification distance)
     /// is not named — the answer says "not told apart from the undeclared …". It runs only
     /// when the chain holds a knob (the answer's names, or a partly explained answer's
