@@ -148,12 +148,14 @@ pub fn audit_undeclared(
         alpha,
         grid_points,
     };
+    // Each named knob's answer without it (start, walked fit), walked once for all passes.
+    let mut withouts: Vec<Option<(Fit, Fit)>> = vec![None; named.len()];
     let mut widened = 0usize;
     for pass in 0..=WIDENINGS {
         if round.is_empty() {
             break;
         }
-        let stopped = weighing.weigh(ctx, current, steps, &round, &mut found)?;
+        let stopped = weighing.weigh(ctx, current, steps, &round, &mut withouts, &mut found)?;
         if pass == WIDENINGS {
             break;
         }
@@ -287,6 +289,7 @@ impl Weighing<'_> {
         current: &Fit,
         steps: &[Step],
         numbers: &[Weighed],
+        withouts: &mut [Option<(Fit, Fit)>],
         found: &mut [Vec<(String, String)>],
     ) -> Result<Vec<Vec<(Test, End)>>, GapError> {
         let n = ctx.n();
@@ -361,9 +364,14 @@ impl Weighing<'_> {
             })
         };
         // What each named knob's look-alike must be significant against: the answer without
-        // it, walked (only for the knobs some number is exchanged for in this pass).
-        let mut withouts: Vec<Option<(Fit, Fit)>> = vec![None; self.named.len()];
+        // it, walked the first time some number is exchanged for it (a later pass reuses it,
+        // as a point of its own knob list: the numbers it does not free are None).
         for (slot, &(_, c)) in self.named.iter().enumerate() {
+            if let Some((start, without)) = &mut withouts[slot] {
+                start.point.resize(knobs.len(), None);
+                without.point.resize(knobs.len(), None);
+                continue;
+            }
             if !numbers
                 .iter()
                 .any(|w| w.tests.contains(&Test::Exchange(slot)))
@@ -391,7 +399,9 @@ impl Weighing<'_> {
             let label = knobs.list[r].label();
             let key = format!("{label}{UNDECLARED}");
             for &test in &w.tests {
-                match test {
+                // The fit, what it must be significant against, the named knobs it would
+                // unname, and how the note says where it stands.
+                let (alt, without, slots, place) = match test {
                     // Every exchange is walked: an undeclared number's curve is walked once
                     // over a wide range, and its surrogate misjudges the exchanges badly (a
                     // lateral foot offset of 0.0006 L screened at χ² 258 walks at 113, beside
@@ -409,21 +419,7 @@ impl Weighing<'_> {
                         set.push(r);
                         let starts = actx.starts_adding(without_start, r);
                         let alt = actx.fit_walked(&set, &starts, None, None)?;
-                        match judge(&alt, without, r) {
-                            Ok((worse_by, x)) => {
-                                if !found[slot].iter().any(|(l, _)| *l == key) {
-                                    found[slot].push((
-                                        key.clone(),
-                                        format!(
-                                            "{label} at {:.4} (χ² {worse_by:+.1})",
-                                            knobs.list[r].value(x)
-                                        ),
-                                    ));
-                                }
-                            }
-                            Err(Some(end)) => stopped[j].push((test, end)),
-                            Err(None) => {}
-                        }
+                        (alt, without, slot..slot + 1, "")
                     }
                     // An answer of several knobs against the number alone in place of all of
                     // them: one number that fits within the identification distance of the
@@ -437,24 +433,28 @@ impl Weighing<'_> {
                         ));
                         let starts = actx.starts_adding(&nominal, r);
                         let alt = actx.fit_walked(&[r], &starts, None, None)?;
-                        match judge(&alt, &nominal, r) {
-                            Ok((worse_by, x)) => {
-                                for alike in found.iter_mut() {
-                                    if !alike.iter().any(|(l, _)| *l == key) {
-                                        alike.push((
-                                            key.clone(),
-                                            format!(
-                                                "{label} at {:.4} alone, in place of the whole answer (χ² {worse_by:+.1})",
-                                                knobs.list[r].value(x)
-                                            ),
-                                        ));
-                                    }
-                                }
+                        (
+                            alt,
+                            &nominal,
+                            0..found.len(),
+                            " alone, in place of the whole answer",
+                        )
+                    }
+                };
+                match judge(&alt, without, r) {
+                    Ok((worse_by, x)) => {
+                        let at = format!(
+                            "{label} at {:.4}{place} (χ² {worse_by:+.1})",
+                            knobs.list[r].value(x)
+                        );
+                        for alike in &mut found[slots] {
+                            if !alike.iter().any(|(l, _)| *l == key) {
+                                alike.push((key.clone(), at.clone()));
                             }
-                            Err(Some(end)) => stopped[j].push((test, end)),
-                            Err(None) => {}
                         }
                     }
+                    Err(Some(end)) => stopped[j].push((test, end)),
+                    Err(None) => {}
                 }
             }
         }

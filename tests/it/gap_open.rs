@@ -1476,18 +1476,7 @@ fn by_default_a_stand_in_for_an_undeclared_number_is_not_named() {
         default.audit_undeclared,
         "the audit is the diagnosis' default"
     );
-    let d = diagnose_committed(
-        "stiction-half-3pct.csv",
-        &["rolling_resistance", "hip_viscous_damping"],
-        &default.select,
-        default.audit_undeclared,
-        &SimCache::default(),
-    );
-    assert_stand_in_unnamed(
-        &d,
-        "mugatu:contact.friction_mu",
-        Some("mugatu:contact.stiction_speed_mps (undeclared)"),
-    );
+    assert_mu_stands_in_for_stiction(&default_diagnosis_of("stiction-half-3pct.csv"));
 }
 
 /// A held-out truth beyond the audit's default range (tools/gap-heldout-check.sh, case
@@ -1498,19 +1487,8 @@ fn by_default_a_stand_in_for_an_undeclared_number_is_not_named() {
 /// and its group holds the undeclared stiction speed.
 #[test]
 fn the_audit_weighs_a_number_again_beyond_the_end_its_fit_stopped_at() {
-    let default = DiagnoseOptions::default();
-    let d = diagnose_committed(
-        "stiction-third-5pct.csv",
-        &["rolling_resistance", "hip_viscous_damping"],
-        &default.select,
-        default.audit_undeclared,
-        &SimCache::default(),
-    );
-    assert_stand_in_unnamed(
-        &d,
-        "mugatu:contact.friction_mu",
-        Some("mugatu:contact.stiction_speed_mps (undeclared)"),
-    );
+    let d = default_diagnosis_of("stiction-third-5pct.csv");
+    assert_mu_stands_in_for_stiction(&d);
     // Found at the truth, outside the default range [0.0005, 0.002].
     assert!(
         d.notes
@@ -1518,6 +1496,29 @@ fn the_audit_weighs_a_number_again_beyond_the_end_its_fit_stopped_at() {
             .any(|n| n.contains("stiction_speed_mps at 0.0003")),
         "{:?}",
         d.notes
+    );
+}
+
+/// The default diagnosis (the audit on) of committed Mugatu trials, with the two effects
+/// the held-out stiction tests weigh beside the calibration.
+fn default_diagnosis_of(file: &str) -> Diagnosis {
+    let default = DiagnoseOptions::default();
+    diagnose_committed(
+        file,
+        &["rolling_resistance", "hip_viscous_damping"],
+        &default.select,
+        default.audit_undeclared,
+        &SimCache::default(),
+    )
+}
+
+/// The held-out stiction truths' right answer: μ not named, grouped with the undeclared
+/// stiction speed.
+fn assert_mu_stands_in_for_stiction(d: &Diagnosis) {
+    assert_stand_in_unnamed(
+        d,
+        "mugatu:contact.friction_mu",
+        Some("mugatu:contact.stiction_speed_mps (undeclared)"),
     );
 }
 
