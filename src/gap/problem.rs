@@ -109,20 +109,67 @@ impl Objective<'_> {
 
     /// The cost at unit coordinates `s` (any real numbers: outside [0, 1] the wall).
     pub fn value(&self, s: &[f64]) -> f64 {
-        let wall: f64 = s
-            .iter()
-            .map(|v| {
-                let d = v - v.clamp(0.0, 1.0);
-                1e4 * d * d
-            })
-            .sum();
         let p = self.point(s);
         let prior = if self.with_prior {
             self.knobs.prior_chi2(&p)
         } else {
             0.0
         };
-        self.data_chi2(&p) + prior + wall
+        self.data_chi2(&p) + prior + wall(s)
+    }
+}
+
+/// The steep quadratic wall outside the unit box (a solver's point is valued at the nearest
+/// point of the box, plus this).
+fn wall(s: &[f64]) -> f64 {
+    s.iter()
+        .map(|v| {
+            let d = v - v.clamp(0.0, 1.0);
+            1e4 * d * d
+        })
+        .sum()
+}
+
+/// The same problem on real walks: the χ² (data + prior) of the point at unit coordinates
+/// `s` of the `active` knobs, the others at `base`, by `chi2_of_point` (walks through the
+/// cache). For a model whose knobs interact where the surrogate's one-knob curves cannot
+/// see it. A walk that fails stops the solver; its error is kept for the caller.
+pub struct WalkedObjective<'a, F> {
+    pub knobs: &'a Knobs,
+    pub active: &'a [usize],
+    pub base: &'a Point,
+    pub chi2_of_point: F,
+    pub error: std::sync::Mutex<Option<super::error::GapError>>,
+}
+
+impl<F> WalkedObjective<'_, F> {
+    /// The point at unit coordinates `s` (clamped into the box).
+    pub fn point(&self, s: &[f64]) -> Point {
+        let clamped: Vec<f64> = s.iter().map(|v| v.clamp(0.0, 1.0)).collect();
+        self.knobs.point_at(self.base, self.active, &clamped)
+    }
+
+    /// The error of the walk that stopped the solver, if one did.
+    pub fn take_error(&self) -> Option<super::error::GapError> {
+        self.error.lock().unwrap_or_else(|e| e.into_inner()).take()
+    }
+}
+
+/// By reference: the solver owns its problem, the caller keeps the walk's error.
+impl<F> CostFunction for &WalkedObjective<'_, F>
+where
+    F: Fn(&Point) -> Result<f64, super::error::GapError>,
+{
+    type Param = Vec<f64>;
+    type Output = f64;
+    fn cost(&self, s: &Self::Param) -> Result<f64, Error> {
+        match (self.chi2_of_point)(&self.point(s)) {
+            Ok(chi2) => Ok(chi2 + wall(s)),
+            Err(e) => {
+                *self.error.lock().unwrap_or_else(|e| e.into_inner()) = Some(e);
+                Err(Error::msg("a walk failed"))
+            }
+        }
     }
 }
 

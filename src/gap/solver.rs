@@ -14,7 +14,7 @@
 //! And Levenberg–Marquardt in the unit box, for a fit on real walks of many knobs (the
 //! residuals are walks: each Jacobian costs one walk per knob).
 
-use argmin::core::{Executor, State};
+use argmin::core::{CostFunction, Executor, State};
 use argmin::solver::neldermead::NelderMead;
 
 use super::problem::Objective;
@@ -34,7 +34,7 @@ pub fn minimize(obj: &Objective<'_>, starts: &[Vec<f64>], step: f64) -> (Vec<f64
     let mut best: Option<(Vec<f64>, f64)> = None;
     for start in starts {
         let s0: Vec<f64> = start.iter().map(|v| v.clamp(0.0, 1.0)).collect();
-        let (s, f) = nelder_mead(obj, &s0, step, max_iters(dim));
+        let (s, f) = nelder_mead(obj.clone(), obj.value(&s0), &s0, step, max_iters(dim), 1e-9);
         if best.as_ref().is_none_or(|(_, bf)| f < *bf) {
             best = Some((s, f));
         }
@@ -44,7 +44,14 @@ pub fn minimize(obj: &Objective<'_>, starts: &[Vec<f64>], step: f64) -> (Vec<f64
     // collapse before the minimum in several dimensions (Lagarias et al. 1998).
     let s: Vec<f64> = s.iter().map(|v| v.clamp(0.0, 1.0)).collect();
     let (s, _) = if dim > 1 {
-        nelder_mead(obj, &s, step / 2.0, max_iters(dim))
+        nelder_mead(
+            obj.clone(),
+            obj.value(&s),
+            &s,
+            step / 2.0,
+            max_iters(dim),
+            1e-9,
+        )
     } else {
         (s.clone(), obj.value(&s))
     };
@@ -53,7 +60,21 @@ pub fn minimize(obj: &Objective<'_>, starts: &[Vec<f64>], step: f64) -> (Vec<f64
     (s, f)
 }
 
-fn nelder_mead(obj: &Objective<'_>, s0: &[f64], step: f64, iters: u64) -> (Vec<f64>, f64) {
+/// argmin's Nelder–Mead on `cost` from `s0` (whose cost is `f0`), an initial simplex of edge
+/// `step` stepping into the unit box, until `iters` iterations or the simplex's costs agree
+/// within `sd_tolerance`. Returns the best point and cost, or the start if nothing beat it
+/// (a cost that fails stops the search there).
+pub fn nelder_mead<C>(
+    cost: C,
+    f0: f64,
+    s0: &[f64],
+    step: f64,
+    iters: u64,
+    sd_tolerance: f64,
+) -> (Vec<f64>, f64)
+where
+    C: CostFunction<Param = Vec<f64>, Output = f64>,
+{
     let dim = s0.len();
     let mut simplex = vec![s0.to_vec()];
     for i in 0..dim {
@@ -66,12 +87,11 @@ fn nelder_mead(obj: &Objective<'_>, s0: &[f64], step: f64, iters: u64) -> (Vec<f
         };
         simplex.push(v);
     }
-    let f0 = obj.value(s0);
-    let solver = match NelderMead::new(simplex).with_sd_tolerance(1e-9) {
+    let solver = match NelderMead::new(simplex).with_sd_tolerance(sd_tolerance) {
         Ok(s) => s,
         Err(_) => return (s0.to_vec(), f0),
     };
-    match Executor::new(obj.clone(), solver)
+    match Executor::new(cost, solver)
         .configure(|state| state.max_iters(iters))
         .run()
     {
