@@ -236,6 +236,13 @@ pub struct SelectionArgs {
     /// no named knob has one.
     #[arg(long)]
     pub look_alikes_at_end: bool,
+    /// Experimental: when the look-ahead unnames a knob because a model one knob larger
+    /// fits better, each model of the answer's size inside that larger one is walked, and
+    /// one that fits within noise and whose knobs form a chain every rule accepts replaces
+    /// the answer (then weighed again). For a look-alike that forward selection took first
+    /// (actuation latency for hip backlash) and that kept the true pair out of reach
+    #[arg(long)]
+    pub within_noise_subset: bool,
     /// `gap benchmark`: run the undeclared-parameter audit on every case (`gap diagnose`
     /// runs it by default; see --no-audit-undeclared). The benchmark's committed figures
     /// are without it, the audit's own in reports/gap-benchmark-audit.points.csv.
@@ -287,6 +294,7 @@ impl SelectionArgs {
             joint_step: self.joint_step,
             walked_lm: self.walked_lm,
             look_alikes_at_end: self.look_alikes_at_end,
+            within_noise_subset: self.within_noise_subset,
             ..base
         }
     }
@@ -310,6 +318,7 @@ impl SelectionArgs {
         flag(self.joint_step, "joint-step");
         flag(self.walked_lm, "walked-lm");
         flag(self.look_alikes_at_end, "look-alikes-at-end");
+        flag(self.within_noise_subset, "within-noise-subset");
         flag(self.audit_undeclared, "audit-undeclared");
         flag(self.no_audit_undeclared, "no-audit-undeclared");
         if self.model_spread > 0 {

@@ -123,6 +123,16 @@ pub struct SelectOptions {
     /// when no named knob has a look-alike in the final model.
     #[serde(skip_serializing_if = "is_false")]
     pub look_alikes_at_end: bool,
+    /// Experimental: when the look-ahead unnames a knob because a model one knob larger
+    /// without it fits better, each model of the answer's size inside that larger one is
+    /// walked; one that fits within noise (inside its ranges) and whose knobs form a chain
+    /// every forward rule accepts replaces the answer (`Selector::within_noise_subset`),
+    /// which is then weighed again by the end comparison and the look-ahead. Forward
+    /// selection can take a look-alike first (actuation latency for hip backlash) and then
+    /// never reach the true pair; the look-ahead sees the pair inside a larger model but
+    /// only takes names away.
+    #[serde(skip_serializing_if = "is_false")]
+    pub within_noise_subset: bool,
 }
 
 fn is_false(b: &bool) -> bool {
@@ -165,6 +175,7 @@ impl SelectOptions {
             deferred_recalibration: false,
             rivals_at_end: false,
             look_alikes_at_end: false,
+            within_noise_subset: false,
         }
     }
 }
@@ -328,8 +339,21 @@ pub fn select(
     } else if opts.rivals_at_end {
         sel.rivals_at_end(&current, &mut steps)?;
     }
+    let mut current = current;
     if opts.look_ahead {
-        sel.look_ahead(&current, &mut steps)?;
+        let larger = sel.look_ahead(&current, &mut steps)?;
+        if opts.within_noise_subset
+            && !larger.is_empty()
+            && !within_noise(&current, sel.n, opts.alpha)
+            && let Some((chain, fit)) = sel.within_noise_subset(&larger, &current)?
+        {
+            steps = chain;
+            current = fit;
+            if opts.rivals_at_end {
+                sel.rivals_at_end(&current, &mut steps)?;
+            }
+            sel.look_ahead(&current, &mut steps)?;
+        }
     }
     if opts.always_recalibrate && !sel.params.is_empty() {
         sel.recalibrated()?;
@@ -1797,12 +1821,19 @@ impl Selector<'_, '_> {
     /// resistance on noiseless trials, exchanged into "damping + rolling" (χ² 53.0) beside
     /// "Coulomb + rolling" (χ² 0.0). A model of the answer's size without `c` that fits
     /// better by the distance, held out too, means `c` is not identified either.
-    fn look_ahead(&mut self, current: &Fit, steps: &mut [Step]) -> Result<(), GapError> {
+    ///
+    /// Returns the models one knob larger that unnamed a knob (their knobs and walked fit).
+    fn look_ahead(
+        &mut self,
+        current: &Fit,
+        steps: &mut [Step],
+    ) -> Result<Vec<(Vec<usize>, Fit)>, GapError> {
         let ctx = self.ctx;
         let knobs = &ctx.knobs.list;
         let n = self.n;
+        let mut larger: Vec<(Vec<usize>, Fit)> = Vec::new();
         if current.active.is_empty() || n <= current.k() + 2 {
-            return Ok(());
+            return Ok(larger);
         }
         ctx.progress
             .stage("looking one knob ahead: is each named knob needed?");
@@ -1825,7 +1856,7 @@ impl Selector<'_, '_> {
         let kept = self.screen_sets(kept, current);
         let kept_surrogate = kept.first().map_or(own, |(_, f)| f.chi2.min(own));
         let Some((_, reference)) = self.best_of(kept, current, LOOK_AHEAD_WALKS)? else {
-            return Ok(());
+            return Ok(larger);
         };
         // The larger model nests the answer: never worse than it, whatever its search found.
         // Its held-out χ² (a dozen refits) only once an alternative beats it.
@@ -1904,8 +1935,78 @@ impl Selector<'_, '_> {
                 alt.chi2,
                 ref_chi2
             ));
+            larger.push((set, alt));
         }
-        Ok(())
+        Ok(larger)
+    }
+
+    /// The models of the answer's size inside the look-ahead's larger models (each larger
+    /// model without one of its knobs), walked from the larger model's values: the best one
+    /// that fits within noise, inside its ranges, other than the answer, whose knobs form a
+    /// chain every forward rule accepts (rebuilt from the nominal). The look-ahead has shown
+    /// that a knob of the answer is not needed; such a model explains the trials without it.
+    /// (The larger model itself is not taken: the look-ahead weighs it against the answer,
+    /// not against the models of its own size.)
+    fn within_noise_subset(
+        &mut self,
+        larger: &[(Vec<usize>, Fit)],
+        current: &Fit,
+    ) -> Result<Option<(Vec<Step>, Fit)>, GapError> {
+        let ctx = self.ctx;
+        let mut own = current.active.clone();
+        own.sort_unstable();
+        let mut tried: Vec<Vec<usize>> = vec![own];
+        let mut fits: Vec<(Vec<usize>, Fit)> = Vec::new();
+        for (set, alt) in larger {
+            for &d in set {
+                let sub: Vec<usize> = set.iter().copied().filter(|k| *k != d).collect();
+                let mut key = sub.clone();
+                key.sort_unstable();
+                if tried.contains(&key) {
+                    continue;
+                }
+                tried.push(key);
+                let starts = self.starts_for_set(&sub, alt);
+                let f = ctx.fit_walked(&sub, &starts, None, None)?;
+                if within_noise(&f, self.n, self.opts.alpha) && inside_ranges(&f) {
+                    fits.push((sub, f));
+                }
+            }
+        }
+        fits.sort_by(|a, b| a.1.chi2.total_cmp(&b.1.chi2));
+        for (sub, f) in fits {
+            let (mut chain, built) = match self.rebuild_chain(&sub)? {
+                Ok(built) => built,
+                Err(why) => {
+                    self.notes.push(format!(
+                        "{} fits these trials within noise (χ² {:.1}) but its knobs do not form \
+                         a chain every rule accepts ({why}): not taken",
+                        self.label_set(&sub),
+                        f.chi2
+                    ));
+                    continue;
+                }
+            };
+            let fit = ctx.with_held_out(if f.chi2 < built.chi2 { f } else { built });
+            self.notes.push(format!(
+                "{} fits these trials within noise (χ² {:.1}) inside a larger model the \
+                 look-ahead found, and its knobs form a chain every rule accepts: it replaced \
+                 {} (χ² {:.1}); the chain below is rebuilt from the nominal",
+                self.label_set(&sub),
+                fit.chi2,
+                self.label_set(&current.active),
+                current.chi2
+            ));
+            if let Some(last) = chain.last_mut() {
+                let gap_after = gap_of(&fit, self.n);
+                last.values_si = self.values_si(&fit);
+                last.gap_after = gap_after;
+                last.shrink_total_pct = 100.0 * (1.0 - gap_after / self.gap0);
+                last.within_noise_after = within_noise(&fit, self.n, self.opts.alpha);
+            }
+            return Ok(Some((chain, fit)));
+        }
+        Ok(None)
     }
 
     /// The step of `label` made ambiguous with `rival` (a step with any rival names none).

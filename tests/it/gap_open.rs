@@ -1167,7 +1167,12 @@ fn a_benchmark_with_other_selection_rules_is_another_benchmark() {
     ] {
         assert!(standard.contains(on), "{on}: {standard}");
     }
-    for off in ["joint_step", "walked_lm", "look_alikes_at_end"] {
+    for off in [
+        "joint_step",
+        "walked_lm",
+        "look_alikes_at_end",
+        "within_noise_subset",
+    ] {
         assert!(!standard.contains(off), "{off}: {standard}");
     }
     let tail = |json: &str| {
@@ -1193,9 +1198,11 @@ fn a_benchmark_with_other_selection_rules_is_another_benchmark() {
         joint_step: true,
         walked_lm: true,
         look_alikes_at_end: true,
+        within_noise_subset: true,
         ..SelectOptions::default()
     };
     let with = serde_json::to_string(&opts).expect("options serialise");
+    assert!(with.contains("\"within_noise_subset\":true"), "{with}");
     assert!(with.contains("\"joint_step\":true"), "{with}");
     assert!(with.contains("\"walked_lm\":true"), "{with}");
     assert!(with.contains("\"look_alikes_at_end\":true"), "{with}");
