@@ -1643,7 +1643,6 @@ impl Selector<'_, '_> {
     fn swap(&mut self, current: &mut Fit, steps: &mut Vec<Step>) -> Result<bool, GapError> {
         let ctx = self.ctx;
         let knobs = &ctx.knobs.list;
-        let n = self.n;
         ctx.progress
             .stage("comparing the model with its neighbours (knobs exchanged)");
         let margin = self.identification_distance(current);
@@ -1714,13 +1713,7 @@ impl Selector<'_, '_> {
                 fit.chi2
             ));
             *steps = chain;
-            if let Some(last) = steps.last_mut() {
-                let gap_after = gap_of(&fit, n);
-                last.values_si = self.values_si(&fit);
-                last.gap_after = gap_after;
-                last.shrink_total_pct = 100.0 * (1.0 - gap_after / self.gap0);
-                last.within_noise_after = within_noise(&fit, n, self.opts.alpha);
-            }
+            self.end_chain_at(steps, &fit);
             *current = fit;
             return Ok(true);
         }
@@ -1997,13 +1990,7 @@ impl Selector<'_, '_> {
                 self.label_set(&current.active),
                 current.chi2
             ));
-            if let Some(last) = chain.last_mut() {
-                let gap_after = gap_of(&fit, self.n);
-                last.values_si = self.values_si(&fit);
-                last.gap_after = gap_after;
-                last.shrink_total_pct = 100.0 * (1.0 - gap_after / self.gap0);
-                last.within_noise_after = within_noise(&fit, self.n, self.opts.alpha);
-            }
+            self.end_chain_at(&mut chain, &fit);
             return Ok(Some((chain, fit)));
         }
         Ok(None)
@@ -2085,6 +2072,18 @@ impl Selector<'_, '_> {
             .walk_sets(screened, from, take, "look-ahead model")?
             .into_iter()
             .min_by(|a, b| a.1.chi2.total_cmp(&b.1.chi2)))
+    }
+
+    /// A rebuilt chain's last step given the answer's model `fit` (the better optimum of the
+    /// same knobs): its values, gap and shrink.
+    fn end_chain_at(&self, steps: &mut [Step], fit: &Fit) {
+        if let Some(last) = steps.last_mut() {
+            let gap_after = gap_of(fit, self.n);
+            last.values_si = self.values_si(fit);
+            last.gap_after = gap_after;
+            last.shrink_total_pct = 100.0 * (1.0 - gap_after / self.gap0);
+            last.within_noise_after = within_noise(fit, self.n, self.opts.alpha);
+        }
     }
 
     /// The chain of forward steps through exactly the knobs `set`, from the nominal, every

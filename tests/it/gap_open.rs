@@ -8,7 +8,9 @@ use std::sync::OnceLock;
 use robot_survey::gap::EffectLibrary;
 use robot_survey::gap::benchmark::{BenchmarkOptions, CaseRow, summarize};
 use robot_survey::gap::cache::SimCache;
-use robot_survey::gap::diagnose::{AnswerKind, DiagnoseOptions, Diagnosis, diagnose_conditions};
+use robot_survey::gap::diagnose::{
+    AnswerKind, DiagnoseOptions, Diagnosis, Named, diagnose_conditions,
+};
 use robot_survey::gap::knob::ModelSetting;
 use robot_survey::gap::select::SelectOptions;
 use robot_survey::gap::simulate::{Condition, resolve};
@@ -420,9 +422,6 @@ fn diagnose_committed(
     audit_undeclared: bool,
     cache: &SimCache,
 ) -> Diagnosis {
-    let s = six();
-    let set = TrialSet::read(&repo().join("tests/data/gap").join(file)).expect("trials");
-    let conditions = resolve(&set).expect("resolve");
     let opts = DiagnoseOptions {
         effects: effects.iter().map(|e| e.to_string()).collect(),
         calibrate: true,
@@ -432,9 +431,26 @@ fn diagnose_committed(
         audit_undeclared,
         ..DiagnoseOptions::default()
     };
-    diagnose_conditions(&set, &conditions, &s.lib, &opts, cache, &Silent)
+    diagnose_committed_with(file, &opts, cache)
+}
+
+/// The diagnosis of committed trials (`tests/data/gap/<file>`) with `opts`.
+fn diagnose_committed_with(file: &str, opts: &DiagnoseOptions, cache: &SimCache) -> Diagnosis {
+    let set = TrialSet::read(&repo().join("tests/data/gap").join(file)).expect("trials");
+    let conditions = resolve(&set).expect("resolve");
+    diagnose_conditions(&set, &conditions, &six().lib, opts, cache, &Silent)
         .expect("diagnosis")
         .0
+}
+
+/// The named knob's 95 % interval holds its truth.
+fn assert_interval_holds(named: &Named, truth: f64) {
+    let [lo, hi] = named.interval;
+    assert!(
+        lo <= truth && truth <= hi,
+        "{}: truth {truth} outside [{lo}, {hi}]",
+        named.knob
+    );
 }
 
 /// The diagnoses of committed trials with the plain selection (`SelectOptions::plain`, the
@@ -610,17 +626,8 @@ fn intervals_of_two_named_knobs_that_trade_off_hold_both_truths() {
         "{}",
         d.answer.statement
     );
-    for (named, truth) in [
-        (&d.answer.parameters[0], 1.5),
-        (&d.answer.effects[0], 0.001_302_241_198_449_636),
-    ] {
-        let [lo, hi] = named.interval;
-        assert!(
-            lo <= truth && truth <= hi,
-            "{}: truth {truth} outside [{lo}, {hi}]",
-            named.knob
-        );
-    }
+    assert_interval_holds(&d.answer.parameters[0], 1.5);
+    assert_interval_holds(&d.answer.effects[0], 0.001_302_241_198_449_636);
 }
 
 /// The benchmark's noisy pair "hip Coulomb friction + motor torque–speed line" (2×
@@ -1784,10 +1791,6 @@ fn a_drake_change_our_model_does_not_share_gets_no_name() {
 /// valley: both named, within 10 %, and their intervals hold the truth.
 #[test]
 fn a_simplex_on_walks_finds_the_narrow_valley_of_two_interacting_effects() {
-    let s = six();
-    let set =
-        TrialSet::read(&repo().join("tests/data/gap/backlash-motor-expected.csv")).expect("trials");
-    let conditions = resolve(&set).expect("resolve");
     let opts = DiagnoseOptions {
         effects: vec!["hip_backlash".into(), "motor_torque_speed".into()],
         calibrate: false,
@@ -1796,28 +1799,11 @@ fn a_simplex_on_walks_finds_the_narrow_valley_of_two_interacting_effects() {
         audit_undeclared: false,
         ..DiagnoseOptions::default()
     };
-    let (d, _) = diagnose_conditions(
-        &set,
-        &conditions,
-        &s.lib,
-        &opts,
-        &SimCache::default(),
-        &Silent,
-    )
-    .expect("diagnosis");
+    let d = diagnose_committed_with("backlash-motor-expected.csv", &opts, &SimCache::default());
     let truths = [("hip_backlash", 10.521), ("motor_torque_speed", 3.6834)];
     assert_pair_named(&d, truths);
     for (knob, truth) in truths {
-        let named = d
-            .answer
-            .effects
-            .iter()
-            .find(|n| n.knob == knob)
-            .expect("named");
-        let [lo, hi] = named.interval;
-        assert!(
-            lo <= truth && truth <= hi,
-            "{knob}: {truth} outside [{lo}, {hi}]"
-        );
+        let named = d.answer.effects.iter().find(|n| n.knob == knob);
+        assert_interval_holds(named.expect("named"), truth);
     }
 }
