@@ -165,13 +165,14 @@ pub struct DiagnoseArgs {
 }
 
 /// The selection's rules (`gap diagnose`, and every case of `gap benchmark`). By default
-/// four rules judge the chain again once it is built: one exchange round, the look-ahead
-/// check, the deferred recalibration test and the step's look-alikes compared at the end;
-/// the flags below switch each off, or add an experimental one.
+/// five rules judge the chain again once it is built: one exchange round, the look-ahead
+/// check, the deferred recalibration test, the step's look-alikes compared at the end and
+/// the within-noise subset of the look-ahead's larger model; the flags below switch each
+/// off, or add an experimental one.
 #[derive(Args, Debug, Clone, Default)]
 #[command(next_help_heading = "Selection rules")]
 pub struct SelectionArgs {
-    /// Forward selection and the backward pass alone, without the four rules that are on by
+    /// Forward selection and the backward pass alone, without the five rules that are on by
     /// default (the selection before 2026-11-28, which the reports' older runs used): to
     /// compare a rule with the selection without it. --exchange-rounds still applies.
     #[arg(long)]
@@ -236,11 +237,16 @@ pub struct SelectionArgs {
     /// no named knob has one.
     #[arg(long)]
     pub look_alikes_at_end: bool,
-    /// Experimental: when the look-ahead unnames a knob because a model one knob larger
-    /// fits better, each model of the answer's size inside that larger one is walked, and
-    /// one that fits within noise and whose knobs form a chain every rule accepts replaces
-    /// the answer (then weighed again). For a look-alike that forward selection took first
-    /// (actuation latency for hip backlash) and that kept the true pair out of reach
+    /// Without the within-noise subset. With it, when the look-ahead unnames a knob because
+    /// a model one knob larger fits better, each model of the answer's size inside that
+    /// larger one is walked, and one that fits within noise and whose knobs form a chain
+    /// every rule accepts replaces the answer (then weighed again). For a look-alike that
+    /// forward selection took first (actuation latency for hip backlash) and that kept the
+    /// true pair out of reach.
+    #[arg(long, conflicts_with = "within_noise_subset")]
+    pub no_within_noise_subset: bool,
+    /// With --plain-selection: the within-noise subset (on by default; it acts only after
+    /// the look-ahead check, so it needs --look-ahead there).
     #[arg(long)]
     pub within_noise_subset: bool,
     /// `gap benchmark`: run the undeclared-parameter audit on every case (`gap diagnose`
@@ -294,7 +300,8 @@ impl SelectionArgs {
             joint_step: self.joint_step,
             walked_lm: self.walked_lm,
             look_alikes_at_end: self.look_alikes_at_end,
-            within_noise_subset: self.within_noise_subset,
+            within_noise_subset: (base.within_noise_subset || self.within_noise_subset)
+                && !self.no_within_noise_subset,
             ..base
         }
     }
@@ -318,6 +325,7 @@ impl SelectionArgs {
         flag(self.joint_step, "joint-step");
         flag(self.walked_lm, "walked-lm");
         flag(self.look_alikes_at_end, "look-alikes-at-end");
+        flag(self.no_within_noise_subset, "no-within-noise-subset");
         flag(self.within_noise_subset, "within-noise-subset");
         flag(self.audit_undeclared, "audit-undeclared");
         flag(self.no_audit_undeclared, "no-audit-undeclared");

@@ -13,10 +13,10 @@
 //!   with a per-model correction from real walks.
 //! * [`problem`] (the χ² cost), [`solver`] (Nelder–Mead, scans), [`fit`] (surrogate fit,
 //!   refinement with walks, held-out χ², profiles, consistency across groups).
-//! * [`select`]: forward selection with the call rules, the backward pass, and four rules
+//! * [`select`]: forward selection with the call rules, the backward pass, and five rules
 //!   that judge the chain again with every cause of it in (on by default: an exchange
 //!   round, the look-ahead check, the deferred recalibration test, look-alikes compared at
-//!   the end); [`audit`]: the answer's named knobs against every number the designs do not
+//!   the end, the within-noise subset of the look-ahead's larger model); [`audit`]: the answer's named knobs against every number the designs do not
 //!   declare (`--audit-undeclared`: one that fits as well in a knob's place unnames it);
 //!   [`diagnose`]: the answer;
 //!   [`locate`]: where the gap lies; [`identify`]: detection and identification thresholds;

@@ -1158,9 +1158,9 @@ fn explore_says_cannot_tell_when_its_sample_is_too_sparse() {
 
 /// The selection's rules are part of a benchmark's signature when the run uses them. The
 /// standard run has the diagnosis' default (one exchange round, the look-ahead check, the
-/// deferred recalibration test, look-alikes compared at the end), as the committed points
-/// file does; a run with the plain selection has the signature of the points files written
-/// before the four were the default (`reports/gap-benchmark-plain.points.csv`); a run with
+/// deferred recalibration test, look-alikes compared at the end, the within-noise subset),
+/// as the committed points file does; a run with the plain selection has the signature of
+/// the points files written before the rules were the default (`reports/gap-benchmark-plain.points.csv`); a run with
 /// any other set of rules cannot be resumed into the committed file.
 #[test]
 fn a_benchmark_with_other_selection_rules_is_another_benchmark() {
@@ -1171,15 +1171,11 @@ fn a_benchmark_with_other_selection_rules_is_another_benchmark() {
         "\"look_ahead\":true",
         "\"deferred_recalibration\":true",
         "\"rivals_at_end\":true",
+        "\"within_noise_subset\":true",
     ] {
         assert!(standard.contains(on), "{on}: {standard}");
     }
-    for off in [
-        "joint_step",
-        "walked_lm",
-        "look_alikes_at_end",
-        "within_noise_subset",
-    ] {
+    for off in ["joint_step", "walked_lm", "look_alikes_at_end"] {
         assert!(!standard.contains(off), "{off}: {standard}");
     }
     let tail = |json: &str| {
@@ -1205,22 +1201,21 @@ fn a_benchmark_with_other_selection_rules_is_another_benchmark() {
         joint_step: true,
         walked_lm: true,
         look_alikes_at_end: true,
-        within_noise_subset: true,
         ..SelectOptions::default()
     };
     let with = serde_json::to_string(&opts).expect("options serialise");
-    assert!(with.contains("\"within_noise_subset\":true"), "{with}");
     assert!(with.contains("\"joint_step\":true"), "{with}");
     assert!(with.contains("\"walked_lm\":true"), "{with}");
     assert!(with.contains("\"look_alikes_at_end\":true"), "{with}");
     // The undeclared-parameter audit: in the signature only when on, as in its own points
-    // file (reports/gap-benchmark-audit.points.csv).
+    // file (reports/gap-benchmark-audit.points.csv). That file was run before the
+    // within-noise subset was a default rule (tenth session), so its signature is the
+    // audit's with the four rules of then.
     assert!(!standard.contains("audit_undeclared"), "{standard}");
-    let audited = serde_json::to_string(&BenchmarkOptions {
-        audit_undeclared: true,
-        ..BenchmarkOptions::standard("mugatu").expect("the bundled cases")
-    })
-    .expect("options serialise");
+    let mut audit_opts = BenchmarkOptions::standard("mugatu").expect("the bundled cases");
+    audit_opts.audit_undeclared = true;
+    audit_opts.select.within_noise_subset = false;
+    let audited = serde_json::to_string(&audit_opts).expect("options serialise");
     let audit_file = std::fs::read_to_string(repo().join("reports/gap-benchmark-audit.points.csv"))
         .expect("the audit's points file");
     let audit_header = audit_file.lines().next().unwrap_or_default();
@@ -1246,6 +1241,7 @@ fn a_benchmark_with_other_selection_rules_is_another_benchmark() {
         &["--no-deferred-recalibration"],
         &["--no-rivals-at-end"],
         &["--look-alikes-at-end"],
+        &["--no-within-noise-subset"],
         &["--audit-undeclared"],
     ] {
         let mut args = vec![
@@ -1800,6 +1796,51 @@ fn a_simplex_on_walks_finds_the_narrow_valley_of_two_interacting_effects() {
         ..DiagnoseOptions::default()
     };
     let d = diagnose_committed_with("backlash-motor-expected.csv", &opts, &SimCache::default());
+    let truths = [("hip_backlash", 10.521), ("motor_torque_speed", 3.6834)];
+    assert_pair_named(&d, truths);
+    for (knob, truth) in truths {
+        let named = d.answer.effects.iter().find(|n| n.knob == knob);
+        assert_interval_holds(named.expect("named"), truth);
+    }
+}
+
+/// The benchmark's noisy pair "hip backlash 10.52° + motor no-load speed 3.683 rad/s" (2×
+/// their identification thresholds, 3 % noise, its own draw:
+/// `tests/data/gap/backlash-motor-3pct-bench.csv`, command in its `source` column),
+/// diagnosed as the benchmark does (every effect, the 12 uncertain parameters calibrated,
+/// no audit). Forward selection takes actuation latency first, a look-alike of backlash;
+/// the look-ahead then unnames it because a model one knob larger without it fits better,
+/// but only takes names away: without the within-noise subset the answer is "partly
+/// explained" with nothing named (measured 2026-11-29: latency, the COM's forward offset,
+/// backlash and the slope in one group). With it, the models of the answer's size inside
+/// that larger one are walked, backlash + the motor line fits within noise and forms a
+/// chain every rule accepts, and both are named with their truths inside their intervals
+/// (reports/gap-benchmark.md, fourteenth session).
+#[test]
+fn the_within_noise_subset_names_the_true_pair_behind_a_look_alike_taken_first() {
+    let cache = SimCache::default();
+    let base = DiagnoseOptions {
+        calibrate: true,
+        explanations: false,
+        identifiability: false,
+        audit_undeclared: false,
+        ..DiagnoseOptions::default()
+    };
+    let without = DiagnoseOptions {
+        select: SelectOptions {
+            within_noise_subset: false,
+            ..SelectOptions::default()
+        },
+        ..base.clone()
+    };
+    let file = "backlash-motor-3pct-bench.csv";
+    let d = diagnose_committed_with(file, &without, &cache);
+    assert!(
+        names(&d).1.len() < 2,
+        "both named without the rule: {}",
+        d.answer.statement
+    );
+    let d = diagnose_committed_with(file, &base, &cache);
     let truths = [("hip_backlash", 10.521), ("motor_torque_speed", 3.6834)];
     assert_pair_named(&d, truths);
     for (knob, truth) in truths {
