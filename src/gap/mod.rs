@@ -16,8 +16,9 @@
 //! * [`select`]: forward selection with the call rules, the backward pass, and five rules
 //!   that judge the chain again with every cause of it in (on by default: an exchange
 //!   round, the look-ahead check, the deferred recalibration test, look-alikes compared at
-//!   the end, the within-noise subset of the look-ahead's larger model); [`audit`]: the answer's named knobs against every number the designs do not
-//!   declare (`--audit-undeclared`: one that fits as well in a knob's place unnames it);
+//!   the end, the within-noise subset of the look-ahead's larger model); [`audit`]: the
+//!   answer's named knobs against every number the designs do not declare
+//!   (`--audit-undeclared`: one that fits as well in a knob's place unnames it);
 //!   [`diagnose`]: the answer;
 //!   [`locate`]: where the gap lies; [`identify`]: detection and identification thresholds;
 //!   [`reference`]: trials carried onto the model through a reference set of the same

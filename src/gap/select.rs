@@ -383,10 +383,10 @@ fn not_beating(lr: f64, p: f64) -> String {
 /// χ² per degree of freedom is at most this. Within noise at α = 0.001 is χ²/dof ≲ 1.5 for
 /// the 60–90 measurements of a trials file; a nested model cannot beat the larger one's
 /// optimum, and the factor 2 beyond that is for the larger fit being a local one (the
-/// benchmark pair it was made for: χ² 137.5 over about 81 degrees of freedom, 1.7). Measured on the
-/// benchmark's Drake cases (χ²/dof in the hundreds) it saves whole walked fits that could
-/// not have been taken. Set too low, the rule only stays silent: the answer is the one
-/// without it.
+/// benchmark pair it was made for: χ² 137.5 over about 81 degrees of freedom, 1.7). On
+/// the benchmark's Drake cases (χ²/dof in the hundreds) it saves whole walked fits that
+/// could not have been taken. Set too low, the rule only stays silent: the answer is the
+/// one without it.
 const SUBSET_REACH_CHI2_PER_DOF: f64 = 3.0;
 
 /// Where a fitted knob counts as inside its plausible range (unit scale): a value at an
@@ -1969,8 +1969,7 @@ impl Selector<'_, '_> {
             // its walked fit is a local one, hence the slack. Far beyond noise (another
             // engine's trials, an error no knob holds), no subset can be within it, and each
             // is a whole walked fit.
-            let dof = self.n.saturating_sub(alt.k()).max(1) as f64;
-            if alt.chi2_data > SUBSET_REACH_CHI2_PER_DOF * dof {
+            if dispersion(alt.chi2_data, self.n, alt.k()) > SUBSET_REACH_CHI2_PER_DOF {
                 continue;
             }
             for &d in set {

@@ -453,6 +453,15 @@ fn assert_interval_holds(named: &Named, truth: f64) {
     );
 }
 
+/// Both effects named (as `assert_pair_named`) and each one's 95 % interval holding its truth.
+fn assert_pair_named_inside_intervals(d: &Diagnosis, truths: [(&str, f64); 2]) {
+    assert_pair_named(d, truths);
+    for (knob, truth) in truths {
+        let named = d.answer.effects.iter().find(|n| n.knob == knob);
+        assert_interval_holds(named.expect("named"), truth);
+    }
+}
+
 /// The diagnoses of committed trials with the plain selection (`SelectOptions::plain`, the
 /// default before 2026-11-28) and with `select` (one walk cache: the second reuses the
 /// first's walks).
@@ -1160,8 +1169,9 @@ fn explore_says_cannot_tell_when_its_sample_is_too_sparse() {
 /// standard run has the diagnosis' default (one exchange round, the look-ahead check, the
 /// deferred recalibration test, look-alikes compared at the end, the within-noise subset),
 /// as the committed points file does; a run with the plain selection has the signature of
-/// the points files written before the rules were the default (`reports/gap-benchmark-plain.points.csv`); a run with
-/// any other set of rules cannot be resumed into the committed file.
+/// the points files written before the rules were the default
+/// (`reports/gap-benchmark-plain.points.csv`); a run with any other set of rules cannot be
+/// resumed into the committed file.
 #[test]
 fn a_benchmark_with_other_selection_rules_is_another_benchmark() {
     let mut opts = BenchmarkOptions::standard("mugatu").expect("the bundled cases");
@@ -1796,12 +1806,10 @@ fn a_simplex_on_walks_finds_the_narrow_valley_of_two_interacting_effects() {
         ..DiagnoseOptions::default()
     };
     let d = diagnose_committed_with("backlash-motor-expected.csv", &opts, &SimCache::default());
-    let truths = [("hip_backlash", 10.521), ("motor_torque_speed", 3.6834)];
-    assert_pair_named(&d, truths);
-    for (knob, truth) in truths {
-        let named = d.answer.effects.iter().find(|n| n.knob == knob);
-        assert_interval_holds(named.expect("named"), truth);
-    }
+    assert_pair_named_inside_intervals(
+        &d,
+        [("hip_backlash", 10.521), ("motor_torque_speed", 3.6834)],
+    );
 }
 
 /// The benchmark's noisy pair "hip backlash 10.52° + motor no-load speed 3.683 rad/s" (2×
@@ -1841,10 +1849,8 @@ fn the_within_noise_subset_names_the_true_pair_behind_a_look_alike_taken_first()
         d.answer.statement
     );
     let d = diagnose_committed_with(file, &base, &cache);
-    let truths = [("hip_backlash", 10.521), ("motor_torque_speed", 3.6834)];
-    assert_pair_named(&d, truths);
-    for (knob, truth) in truths {
-        let named = d.answer.effects.iter().find(|n| n.knob == knob);
-        assert_interval_holds(named.expect("named"), truth);
-    }
+    assert_pair_named_inside_intervals(
+        &d,
+        [("hip_backlash", 10.521), ("motor_torque_speed", 3.6834)],
+    );
 }
