@@ -249,6 +249,16 @@ pub struct SelectionArgs {
     /// the look-ahead check, so it needs --look-ahead there).
     #[arg(long)]
     pub within_noise_subset: bool,
+    /// Without the stop at the simulator's resolution. With it, forward selection stops
+    /// where the model is beyond noise by the measurements' sds but within it once the
+    /// simulator's own resolution at the model (the metrics' spread over nudges of 1/256 of
+    /// each knob's range) is counted beside them, as the answer's residual check does: where
+    /// the gait is knife-edge a further knob fits the chaos, not a cause
+    #[arg(long, conflicts_with = "stop_at_resolution")]
+    pub no_stop_at_resolution: bool,
+    /// With --plain-selection: the stop at the simulator's resolution (on by default).
+    #[arg(long)]
+    pub stop_at_resolution: bool,
     /// `gap benchmark`: run the undeclared-parameter audit on every case (`gap diagnose`
     /// runs it by default; see --no-audit-undeclared). The benchmark's committed figures
     /// are without it, the audit's own in reports/gap-benchmark-audit.points.csv.
@@ -302,6 +312,8 @@ impl SelectionArgs {
             look_alikes_at_end: self.look_alikes_at_end,
             within_noise_subset: (base.within_noise_subset || self.within_noise_subset)
                 && !self.no_within_noise_subset,
+            stop_at_resolution: (base.stop_at_resolution || self.stop_at_resolution)
+                && !self.no_stop_at_resolution,
             ..base
         }
     }
@@ -327,6 +339,8 @@ impl SelectionArgs {
         flag(self.look_alikes_at_end, "look-alikes-at-end");
         flag(self.no_within_noise_subset, "no-within-noise-subset");
         flag(self.within_noise_subset, "within-noise-subset");
+        flag(self.no_stop_at_resolution, "no-stop-at-resolution");
+        flag(self.stop_at_resolution, "stop-at-resolution");
         flag(self.audit_undeclared, "audit-undeclared");
         flag(self.no_audit_undeclared, "no-audit-undeclared");
         if self.model_spread > 0 {

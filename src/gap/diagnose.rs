@@ -956,15 +956,7 @@ fn answer(
     // Intervals and the residual check count the simulator's resolution at the answer as
     // an error of its own, beside the measurement's: where the gait is knife-edge the data
     // cannot pin a knob closer than a nudge that changes the gait.
-    let resolution = ctx.resolution(final_fit)?;
-    let inflated: Vec<Observation> = ctx
-        .obs
-        .iter()
-        .map(|o| Observation {
-            sd: o.sd.hypot(resolution[o.trial][o.metric.index()]),
-            ..*o
-        })
-        .collect();
+    let (inflated, _) = ctx.at_resolution(final_fit)?;
     let rctx = FitContext {
         obs: &inflated,
         ..*ctx

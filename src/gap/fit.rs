@@ -733,6 +733,24 @@ impl<'a> FitContext<'a> {
         })
     }
 
+    /// The observations with each sd widened by the simulator's resolution at `fit`
+    /// ([`Self::resolution`]), and `fit`'s data χ² against them: the error the answer's
+    /// residual check counts beside the measurement's, and the selection's stop
+    /// (`SelectOptions::stop_at_resolution`). `None` for the χ² of a fit without walks.
+    pub fn at_resolution(&self, fit: &Fit) -> Result<(Vec<Observation>, Option<f64>), GapError> {
+        let resolution = self.resolution(fit)?;
+        let obs: Vec<Observation> = self
+            .obs
+            .iter()
+            .map(|o| Observation {
+                sd: o.sd.hypot(resolution[o.trial][o.metric.index()]),
+                ..*o
+            })
+            .collect();
+        let chi2 = fit.sims.as_ref().map(|sims| chi2_of(&obs, sims).0);
+        Ok((obs, chi2))
+    }
+
     /// The simulator's resolution at a fit's point: the sd of each condition's metrics over
     /// the fit and four walks with every free knob nudged by 1/256 of its range (signs
     /// (+,+,…), (−,−,…), (+,−,+,…), (−,+,−,…)). Where the gait is knife-edge (a regime

@@ -136,6 +136,16 @@ pub struct SelectOptions {
     /// every benchmark case the look-ahead could have acted on.
     #[serde(skip_serializing_if = "is_false")]
     pub within_noise_subset: bool,
+    /// Forward selection stops where the model is within noise once the simulator's
+    /// resolution at it is counted beside the measurement's sd (`FitContext::at_resolution`,
+    /// the answer's own residual check). Where the gait is knife-edge (a regime change a
+    /// hair from the fitted point: the benchmark's one-robot COM height 0.495, which flips
+    /// two of twelve conditions out of walking) no point near the truth reproduces the trials
+    /// exactly, and a second knob bought 22.3 → 5.6 RMS z by fitting that chaos: the servo's
+    /// damping gain named beside the true COM height. A knob is added only to explain what
+    /// the model, at its resolution, cannot. On by default (sixteenth session).
+    #[serde(skip_serializing_if = "is_false")]
+    pub stop_at_resolution: bool,
 }
 
 fn is_false(b: &bool) -> bool {
@@ -158,6 +168,7 @@ impl Default for SelectOptions {
             deferred_recalibration: true,
             rivals_at_end: true,
             within_noise_subset: true,
+            stop_at_resolution: true,
             ..SelectOptions::plain()
         }
     }
@@ -180,6 +191,7 @@ impl SelectOptions {
             rivals_at_end: false,
             look_alikes_at_end: false,
             within_noise_subset: false,
+            stop_at_resolution: false,
         }
     }
 }
@@ -349,6 +361,7 @@ pub fn select(
         if opts.within_noise_subset
             && !larger.is_empty()
             && !within_noise(&current, sel.n, opts.alpha)
+            && !sel.stops_at_resolution(&current)?
             && let Some((chain, fit)) = sel.within_noise_subset(&larger, &current)?
         {
             steps = chain;
@@ -918,9 +931,41 @@ impl Selector<'_, '_> {
         Ok(())
     }
 
+    /// `SelectOptions::stop_at_resolution`: `current` (with a knob or more) is beyond noise
+    /// by the measurements' sds alone but within it with the simulator's resolution at it
+    /// counted beside them. Four walks per condition, cached.
+    fn stops_at_resolution(&self, current: &Fit) -> Result<bool, GapError> {
+        if !self.opts.stop_at_resolution
+            || current.active.is_empty()
+            || within_noise(current, self.n, self.opts.alpha)
+        {
+            return Ok(false);
+        }
+        let Some(chi2) = self.ctx.at_resolution(current)?.1 else {
+            return Ok(false);
+        };
+        let dof = self.n.saturating_sub(current.k());
+        Ok(dof > 0 && chi2_upper_p(chi2, dof as f64).unwrap_or(0.0) >= self.opts.alpha)
+    }
+
     /// Forward steps from `current` until nothing passes or the step limit.
     fn forward(&mut self, current: &mut Fit, steps: &mut Vec<Step>) -> Result<(), GapError> {
         while steps.len() < self.opts.max_steps {
+            if self.stops_at_resolution(current)? {
+                let note = format!(
+                    "the search stopped after {} knob(s): beyond noise by the measurements' sds \
+                     (held-out RMS z {:.2}) but within it once the simulator's resolution at the model \
+                     is counted (the gait is knife-edge there: a nudge of 1/256 of each knob's \
+                     range changes the metrics by as much as the gap left); a further knob \
+                     would fit that chaos, not a cause",
+                    current.active.len(),
+                    gap_of(current, self.n),
+                );
+                if !self.notes.contains(&note) {
+                    self.notes.push(note);
+                }
+                break;
+            }
             match self.step(current, steps.len())? {
                 Outcome::Chosen(chosen) => {
                     let (step, real, nb) = *chosen;

@@ -852,6 +852,56 @@ fn a_drake_made_null_case_is_not_blamed_on_an_effect() {
     );
 }
 
+/// A knife-edge gait: the one-robot benchmark's COM height 0.495 L (the file's 0.45, +10 %;
+/// 5 % noise, the benchmark's own draw: `tests/data/gap/com-height-knife-edge-5pct-bench.csv`,
+/// command in its `source` column, conditions `gap::benchmark::one_robot_conditions`). At
+/// this COM two of the twelve conditions (f1.03x, A+4) stop walking, and no COM near the
+/// truth reproduces the others closer than 22 RMS z by the measurements' sds: a nudge of
+/// 1/256 of the range changes the metrics as much. Without the stop at the simulator's
+/// resolution the search went on and named the servo's damping gain too, 1.17–1.34
+/// against the file's 2.0 (gap left 5.6, 49,104 walks; reports/gap-benchmark.md,
+/// fifteenth session), a wrong parameter. With it the COM height alone is named, its
+/// interval holding the truth.
+#[test]
+fn a_knife_edge_gait_stops_the_search_at_the_simulators_resolution() {
+    let opts = DiagnoseOptions {
+        explanations: false,
+        identifiability: false,
+        audit_undeclared: false,
+        ..DiagnoseOptions::default()
+    };
+    assert!(opts.select.stop_at_resolution, "on by default");
+    let d = diagnose_committed_with(
+        "com-height-knife-edge-5pct-bench.csv",
+        &opts,
+        &SimCache::default(),
+    );
+    let (params, effects) = names(&d);
+    assert_eq!(
+        d.answer.kind,
+        AnswerKind::ParametersOff,
+        "{}",
+        d.answer.statement
+    );
+    assert!(
+        effects.is_empty(),
+        "an effect named: {}",
+        d.answer.statement
+    );
+    assert_eq!(
+        params,
+        vec!["mugatu:mass.leg_com_height_over_l".to_string()],
+        "{}",
+        d.answer.statement
+    );
+    assert_interval_holds(&d.answer.parameters[0], 0.495);
+    assert!(
+        d.notes.iter().any(|n| n.contains("simulator's resolution")),
+        "the stop is the rule's: {:?}",
+        d.notes
+    );
+}
+
 /// The paths the bundled Mugatu declares uncertain (read once for every hand-made row).
 fn mugatu_uncertain() -> &'static [String] {
     static PATHS: OnceLock<Vec<String>> = OnceLock::new();
@@ -1167,7 +1217,8 @@ fn explore_says_cannot_tell_when_its_sample_is_too_sparse() {
 
 /// The selection's rules are part of a benchmark's signature when the run uses them. The
 /// standard run has the diagnosis' default (one exchange round, the look-ahead check, the
-/// deferred recalibration test, look-alikes compared at the end, the within-noise subset),
+/// deferred recalibration test, look-alikes compared at the end, the within-noise subset,
+/// the stop at the simulator's resolution),
 /// as the committed points file does; a run with the plain selection has the signature of
 /// the points files written before the rules were the default
 /// (`reports/gap-benchmark-plain.points.csv`); a run with any other set of rules cannot be
@@ -1182,6 +1233,7 @@ fn a_benchmark_with_other_selection_rules_is_another_benchmark() {
         "\"deferred_recalibration\":true",
         "\"rivals_at_end\":true",
         "\"within_noise_subset\":true",
+        "\"stop_at_resolution\":true",
     ] {
         assert!(standard.contains(on), "{on}: {standard}");
     }
@@ -1219,12 +1271,13 @@ fn a_benchmark_with_other_selection_rules_is_another_benchmark() {
     assert!(with.contains("\"look_alikes_at_end\":true"), "{with}");
     // The undeclared-parameter audit: in the signature only when on, as in its own points
     // file (reports/gap-benchmark-audit.points.csv). That file was run before the
-    // within-noise subset was a default rule (tenth session), so its signature is the
-    // audit's with the four rules of then.
+    // within-noise subset and the stop at the resolution were default rules (tenth
+    // session), so its signature is the audit's with the four rules of then.
     assert!(!standard.contains("audit_undeclared"), "{standard}");
     let mut audit_opts = BenchmarkOptions::standard("mugatu").expect("the bundled cases");
     audit_opts.audit_undeclared = true;
     audit_opts.select.within_noise_subset = false;
+    audit_opts.select.stop_at_resolution = false;
     let audited = serde_json::to_string(&audit_opts).expect("options serialise");
     let audit_file = std::fs::read_to_string(repo().join("reports/gap-benchmark-audit.points.csv"))
         .expect("the audit's points file");
@@ -1252,6 +1305,7 @@ fn a_benchmark_with_other_selection_rules_is_another_benchmark() {
         &["--no-rivals-at-end"],
         &["--look-alikes-at-end"],
         &["--no-within-noise-subset"],
+        &["--no-stop-at-resolution"],
         &["--audit-undeclared"],
     ] {
         let mut args = vec![
