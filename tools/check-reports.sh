@@ -51,11 +51,19 @@ for f in feet.md feet.csv feet.json feet.svg; do same "$T/feet/$f" "$f"; done
 "$S" sim crosscheck --format md >"$T/cc.md" 2>/dev/null; contained "$T/cc.md" drake-crosscheck.md
 "$S" gap diagnose --trials dataset/trials/published.csv --plot "$T/gp.svg" >"$T/gp.md" 2>/dev/null
 prefix "$T/gp.md" gap-published.md; same "$T/gp.svg" gap-published.svg
-"$S" gap benchmark --design mugatu --quick --noise 0.03,0.05 --null-cases 300 --one-robot-nulls 100 \
+"$S" gap benchmark --design mugatu --quick --noise 0.03,0.05 --null-cases 300 --one-robot-nulls 300 \
   --drake tests/golden/drake/gap --merge reports/gap-benchmark.points.csv \
   --points "$T/gb.points.csv" --out "$T/gb" >/dev/null 2>&1
 prefix "$T/gb/gap-benchmark.md" gap-benchmark.md
 same "$T/gb/gap-benchmark.json" gap-benchmark.json; same "$T/gb/gap-benchmark.svg" gap-benchmark.svg
+# The shipped default's audit (with its declared partners) on the compound and
+# parameter-error cases (seventeenth session).
+"$S" gap benchmark --design mugatu --quick --noise 0.03,0.05 --null-cases 300 --one-robot-nulls 300 \
+  --drake tests/golden/drake/gap --audit-undeclared --merge reports/gap-benchmark-audit-partners.points.csv \
+  --points "$T/gap.points.csv" --out "$T/gap" >/dev/null 2>&1
+prefix "$T/gap/gap-benchmark.md" gap-benchmark-audit-partners/gap-benchmark.md
+same "$T/gap/gap-benchmark.json" gap-benchmark-audit-partners/gap-benchmark.json
+same "$T/gap/gap-benchmark.svg" gap-benchmark-audit-partners/gap-benchmark.svg
 "$S" gap benchmark --design zippy --quick --merge reports/gap-benchmark-zippy.points.csv \
   --points "$T/gz.points.csv" --out "$T/gz" >/dev/null 2>&1
 prefix "$T/gz/gap-benchmark.md" gap-benchmark-zippy/gap-benchmark.md

@@ -286,6 +286,7 @@ def diagnose(
     calibrate: bool = True,
     reference: Optional[TrialsArg] = None,
     audit_undeclared: bool = True,
+    audit_partners: int = 2,
 ) -> Diagnosis:
     """Diagnoses trials against the simulator (``survey gap diagnose``); runs with the GIL
     released.
@@ -316,6 +317,10 @@ def diagnose(
         Weigh each named knob against the design's undeclared numbers (False is
         ``--no-audit-undeclared``): one that an undeclared number fits as well is not named
         but listed with it as "not told apart".
+    audit_partners:
+        The audit's declared partners (``--audit-partners``; 0: one undeclared number at a
+        time): an undeclared number that explains part of the gap in a named knob's place is
+        weighed again beside the best few declared knobs, for a truth of two numbers.
     """
     a = _trials_args(trials)
     r = _trials_args(reference) if reference is not None else None
@@ -333,5 +338,6 @@ def diagnose(
         r["text"] if r else None,
         (r["origin"] or "<DataFrame>") if r else "<DataFrame>",
         bool(audit_undeclared),
+        int(audit_partners),
     )
     return Diagnosis(json.loads(text), json.loads(timing))

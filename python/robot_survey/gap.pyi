@@ -105,4 +105,5 @@ def diagnose(
     calibrate: bool = True,
     reference: Optional[_Trials] = None,
     audit_undeclared: bool = True,
+    audit_partners: int = 2,
 ) -> Diagnosis: ...

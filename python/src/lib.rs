@@ -614,9 +614,10 @@ fn gap_synth_csv(
 
 /// `survey gap diagnose --format json`, and the wall-clock timing (not part of the result).
 /// `reference_*`: the reference trials (`survey gap diagnose --reference`), as path or text
-/// like the trials; `audit_undeclared` false is `--no-audit-undeclared`.
+/// like the trials; `audit_undeclared` false is `--no-audit-undeclared`, `audit_partners`
+/// is `--audit-partners`.
 #[pyfunction]
-#[pyo3(signature = (path=None, text=None, origin="<DataFrame>", base_dir=None, effects=Vec::new(), grid=9, default_sd=0.10, alpha=0.001, calibrate=true, reference_path=None, reference_text=None, reference_origin="<DataFrame>", audit_undeclared=true))]
+#[pyo3(signature = (path=None, text=None, origin="<DataFrame>", base_dir=None, effects=Vec::new(), grid=9, default_sd=0.10, alpha=0.001, calibrate=true, reference_path=None, reference_text=None, reference_origin="<DataFrame>", audit_undeclared=true, audit_partners=gap::audit::PARTNERS))]
 #[allow(clippy::too_many_arguments)]
 fn gap_diagnose_json(
     py: Python<'_>,
@@ -633,6 +634,7 @@ fn gap_diagnose_json(
     reference_text: Option<String>,
     reference_origin: &str,
     audit_undeclared: bool,
+    audit_partners: usize,
 ) -> PyResult<(String, String)> {
     let origin = origin.to_string();
     let reference_origin = reference_origin.to_string();
@@ -654,6 +656,7 @@ fn gap_diagnose_json(
             calibrate,
             reference,
             audit_undeclared,
+            audit_partners,
             ..DiagnoseOptions::default()
         };
         let (d, timing) = gap::diagnose(&set, &lib, &opts, &Silent)?;

@@ -279,6 +279,15 @@ pub struct SelectionArgs {
     /// limit).
     #[arg(long)]
     pub no_audit_undeclared: bool,
+    /// The audit's declared partners (0: one undeclared number at a time). An undeclared
+    /// number that, in a named knob's place, explains part of the gap but not all of it is
+    /// walked again beside each of the N declared knobs the surrogate ranks best: a truth
+    /// of two numbers, one of them undeclared (the leg's roll inertia +30 % with μ 3 % low),
+    /// can be fitted by neither alone, and the selection names a declared stand-in for the
+    /// pair. The pair unnames the knob when, charged 2·φ for its knob more, it fits within
+    /// the identification distance and each of its two is significant beside the other
+    #[arg(long, value_name = "N", default_value_t = gap::audit::PARTNERS)]
+    pub audit_partners: usize,
     /// Experimental: count the model's own trial-to-trial spread as noise. The nominal is
     /// walked at every condition from N starts perturbed by the design's [initial] seed table,
     /// and the sd of each metric over them (and the unperturbed walk) is added to the
@@ -343,6 +352,9 @@ impl SelectionArgs {
         flag(self.stop_at_resolution, "stop-at-resolution");
         flag(self.audit_undeclared, "audit-undeclared");
         flag(self.no_audit_undeclared, "no-audit-undeclared");
+        if self.audit_partners != gap::audit::PARTNERS {
+            f.push_str(&format!(" --audit-partners {}", self.audit_partners));
+        }
         if self.model_spread > 0 {
             f.push_str(&format!(" --model-spread {}", self.model_spread));
         }
@@ -845,6 +857,7 @@ fn diagnose(a: &DiagnoseArgs) -> anyhow::Result<ExitCode> {
         calibrate: !a.no_calibration,
         select: a.selection.options(),
         audit_undeclared: !a.selection.no_audit_undeclared,
+        audit_partners: a.selection.audit_partners,
         model_spread_seeds: a.selection.model_spread,
         ..DiagnoseOptions::default()
     };
@@ -948,6 +961,11 @@ fn benchmark(a: &BenchmarkArgs) -> anyhow::Result<ExitCode> {
     }
     opts.select = a.selection.options();
     opts.audit_undeclared = a.selection.audit_undeclared;
+    opts.audit_partners = if a.selection.audit_undeclared {
+        a.selection.audit_partners as u64
+    } else {
+        0
+    };
     opts.model_spread_seeds = a.selection.model_spread;
     if let Some(n) = &a.noise {
         if let Some(bad) = n.iter().find(|x| !(**x > 0.0 && **x < 1.0)) {

@@ -99,6 +99,11 @@ pub struct BenchmarkOptions {
     /// signature only when on.
     #[serde(default, skip_serializing_if = "std::ops::Not::not")]
     pub audit_undeclared: bool,
+    /// With the audit: the declared partners walked beside an undeclared number
+    /// ([`DiagnoseOptions::audit_partners`]); written into the signature only when > 0, so
+    /// the audit's points file of one number at a time keeps its signature.
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub audit_partners: u64,
     /// The model's spread over this many perturbed starts counted as noise in every case
     /// ([`super::diagnose::model_spread`]); written into the signature only when > 0.
     #[serde(default, skip_serializing_if = "is_zero")]
@@ -143,6 +148,7 @@ impl BenchmarkOptions {
             effects: Vec::new(),
             select: SelectOptions::default(),
             audit_undeclared: false,
+            audit_partners: 0,
             model_spread_seeds: 0,
             drake_reference: false,
         }
@@ -394,6 +400,7 @@ pub struct Plan {
     /// The selection's options of every case (the rules the run asks for).
     select: SelectOptions,
     audit_undeclared: bool,
+    audit_partners: u64,
     model_spread_seeds: u64,
     drake_reference: bool,
     suites: Vec<Suite>,
@@ -479,6 +486,11 @@ pub fn plan(
         thresholds: thr.table,
         select: opts.select.clone(),
         audit_undeclared: opts.audit_undeclared,
+        audit_partners: if opts.audit_undeclared {
+            opts.audit_partners
+        } else {
+            0
+        },
         model_spread_seeds: opts.model_spread_seeds,
         drake_reference: opts.drake_reference,
         suites,
@@ -948,6 +960,7 @@ fn run_case(
         identifiability: false,
         select: plan.select.clone(),
         audit_undeclared: plan.audit_undeclared,
+        audit_partners: plan.audit_partners as usize,
         model_spread_seeds: plan.model_spread_seeds,
         ..DiagnoseOptions::default()
     };

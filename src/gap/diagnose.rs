@@ -54,6 +54,11 @@ pub struct DiagnoseOptions {
     /// stand-ins into "not told apart" groups holding the truth (reports/gap-benchmark.md,
     /// eleventh session); the benchmark runs it only when asked (its figures are without it).
     pub audit_undeclared: bool,
+    /// The audit's declared partners: an undeclared number that, in a named knob's place,
+    /// explains part of the gap is walked again beside this many declared knobs (the
+    /// surrogate's best), for a truth of two numbers, one undeclared ([`super::audit`]);
+    /// 0: one number at a time.
+    pub audit_partners: usize,
     /// Count the model's own trial-to-trial spread as an error beside each measurement's:
     /// the nominal walked from this many perturbed starts ([`model_spread`]); 0: off.
     pub model_spread_seeds: u64,
@@ -75,6 +80,7 @@ impl Default for DiagnoseOptions {
             explanations: true,
             select: SelectOptions::default(),
             audit_undeclared: true,
+            audit_partners: super::audit::PARTNERS,
             model_spread_seeds: 0,
             reference: None,
         }
@@ -623,8 +629,11 @@ pub fn diagnose_conditions(
             &designs,
             &final_fit,
             &mut steps,
-            opts.alpha,
-            opts.grid_points,
+            super::audit::AuditSettings {
+                alpha: opts.alpha,
+                grid_points: opts.grid_points,
+                partners: opts.audit_partners,
+            },
             &mut notes,
         )?;
     }
