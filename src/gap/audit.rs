@@ -278,6 +278,14 @@ enum End {
     High,
 }
 
+/// A named knob as the partner step needs it: its index, the answer without it, and each
+/// partner's fit alone in its place (walked once, shared by every number paired with it).
+struct KnobPlace<'a> {
+    c: usize,
+    without: &'a Fit,
+    partners_alone: &'a mut std::collections::BTreeMap<usize, Fit>,
+}
+
 /// What one test of a number found.
 enum Outcome {
     /// A look-alike: χ² above the answer, the number's coordinate.
@@ -347,7 +355,7 @@ struct Weighing<'a> {
 }
 
 impl Weighing<'_> {
-    /// The number `r`, significant in named knob `c`'s place but short of a look-alike,
+    /// The number `r`, significant in the place of named knob `place.c` but short of a look-alike,
     /// with one declared knob beside it: the truth may be an undeclared number and a
     /// declared one together, which neither the exchange (one number) nor the selection
     /// (declared knobs only) can fit. Every declared knob outside the exchange is screened
@@ -362,11 +370,15 @@ impl Weighing<'_> {
         &self,
         actx: &FitContext<'_>,
         current: &Fit,
-        without: &Fit,
         alt: &Fit,
         r: usize,
-        c: usize,
+        place: KnobPlace<'_>,
     ) -> Result<Option<(f64, f64, usize, f64)>, GapError> {
+        let KnobPlace {
+            c,
+            without,
+            partners_alone,
+        } = place;
         let n = actx.n();
         // (χ² on the surrogate, partner, its starts, the screened fit).
         type Screened = (f64, usize, Vec<(Point, Correction)>, Fit);
@@ -402,11 +414,23 @@ impl Weighing<'_> {
             {
                 continue;
             }
-            let mut set = without.active.clone();
-            set.push(d);
-            let partner_alone =
-                actx.fit_walked(&set, &actx.starts_adding(without, d), None, Some(without))?;
-            if lr_p_value(partner_alone.chi2 - pair.chi2, 1, phi, dof) >= alpha {
+            // The partner alone in the knob's place: the same fit for every number paired
+            // with it, walked once per knob and pass.
+            let partner_alone = match partners_alone.get(&d) {
+                Some(f) => f.chi2,
+                None => {
+                    let mut set = without.active.clone();
+                    set.push(d);
+                    let f = actx.fit_walked(
+                        &set,
+                        &actx.starts_adding(without, d),
+                        None,
+                        Some(without),
+                    )?;
+                    partners_alone.entry(d).or_insert(f).chi2
+                }
+            };
+            if lr_p_value(partner_alone - pair.chi2, 1, phi, dof) >= alpha {
                 continue;
             }
             if let (Some(x), Some(y)) = (pair.point[r], pair.point[d]) {
@@ -621,6 +645,9 @@ impl Weighing<'_> {
         if self.partners > 0 {
             parts.sort_by(|a, b| a.0.cmp(&b.0).then(a.2.chi2.total_cmp(&b.2.chi2)));
             let mut taken = vec![0usize; self.named.len()];
+            // Per named knob: each partner's fit alone in the knob's place.
+            let mut alone: Vec<std::collections::BTreeMap<usize, Fit>> =
+                vec![Default::default(); self.named.len()];
             for (slot, r, alt) in parts {
                 if taken[slot] >= PARTIAL_NUMBERS {
                     continue;
@@ -630,8 +657,13 @@ impl Weighing<'_> {
                     continue;
                 };
                 let (_, c) = self.named[slot];
+                let place = KnobPlace {
+                    c,
+                    without,
+                    partners_alone: &mut alone[slot],
+                };
                 let Some((worse_by, x, d, y)) =
-                    self.with_partner(&actx, &current, without, &alt, r, c)?
+                    self.with_partner(&actx, &current, &alt, r, place)?
                 else {
                     continue;
                 };
