@@ -47,7 +47,7 @@ pub enum GapCommand {
     WaveformBenchmark(WaveformBenchArgs),
     /// Every effect at several magnitudes × noise levels × seeds, plus null cases:
     /// identification confusion matrix, parameter recovery, shrink.
-    Benchmark(BenchmarkArgs),
+    Benchmark(Box<BenchmarkArgs>),
 }
 
 #[derive(Clone, Copy, Debug, Default, ValueEnum)]
@@ -544,6 +544,11 @@ pub struct BenchmarkArgs {
     /// Noisy copies of each Drake trials file (default 5; 1 with --quick).
     #[arg(long, value_name = "N", requires = "drake")]
     pub drake_seeds: Option<u64>,
+    /// Diagnose the Drake cases against this design instead of their files' (a bundled name
+    /// or a path relative to the Drake folder): e.g. `mugatu-ref-sap`, the reference with
+    /// Drake SAP's convex friction cone, for trials Drake-SAP made from `mugatu-ref`.
+    #[arg(long, value_name = "DESIGN", requires = "drake")]
+    pub drake_design: Option<String>,
     /// Effects to benchmark (default: all).
     #[arg(long, value_delimiter = ',')]
     pub effects: Vec<String>,
@@ -975,6 +980,7 @@ fn benchmark(a: &BenchmarkArgs) -> anyhow::Result<ExitCode> {
     }
     opts.drake_dir = a.drake.clone();
     opts.drake_reference = a.drake_reference;
+    opts.drake_design = a.drake_design.clone();
     opts.effects = a.effects.clone();
     let shard = a.shard.unwrap_or(Shard::WHOLE);
     if shard != Shard::WHOLE && a.points.is_none() {
@@ -1067,6 +1073,9 @@ fn benchmark(a: &BenchmarkArgs) -> anyhow::Result<ExitCode> {
     }
     if let Some(n) = a.drake_seeds {
         command.push_str(&format!(" --drake-seeds {n}"));
+    }
+    if let Some(d) = &a.drake_design {
+        command.push_str(&format!(" --drake-design {d}"));
     }
     if a.drake_reference {
         command.push_str(" --drake-reference");

@@ -17,8 +17,8 @@ use serde::{Deserialize, Serialize};
 
 use crate::progress::Observer;
 use crate::sim::{
-    Controller, Design, GRAVITY_MPS2, SimError, Simulator, State, WalkOptions, WalkReport,
-    hip_frame_attitude, read_trajectory_csv, report_from_trajectory, simulate_walk,
+    Controller, Design, FrictionCone, GRAVITY_MPS2, SimError, Simulator, State, WalkOptions,
+    WalkReport, hip_frame_attitude, read_trajectory_csv, report_from_trajectory, simulate_walk,
 };
 
 /// Errors of the cross-check (reading goldens, running cases).
@@ -428,6 +428,17 @@ impl CaseKind {
     }
 }
 
+/// The case with the project's convex friction cone (`contact.friction_cone = "convex"`,
+/// the relaxation Drake's SAP and `similar` solve with) in place of Coulomb friction.
+pub fn with_convex_cone(case: &Case) -> Case {
+    let mut c = case.clone();
+    c.overrides.insert(
+        "contact.friction_cone".to_string(),
+        toml::Value::String("convex".to_string()),
+    );
+    c
+}
+
 /// Runs a case in the project's engine and measures it as the Drake harness does.
 pub fn run_case(root: &Path, name: &str, case: &Case) -> Result<Measured, CrosscheckError> {
     let design = case_design(root, case)?;
@@ -644,6 +655,9 @@ pub struct WalkComparison {
     pub drake_approximation: Option<String>,
     /// The project's walk.
     pub project: WalkReport,
+    /// The project's walk with the convex friction cone (`friction_cone = "convex"`), for
+    /// a golden whose Drake approximation is convex (SAP, `similar`); `None` for `lagged`.
+    pub project_convex: Option<WalkReport>,
     /// Drake's trajectory measured by the project's gait metrics.
     pub drake: WalkReport,
 }
@@ -754,16 +768,32 @@ pub fn read_walk_golden(root: &Path, json_path: &Path) -> Result<WalkGolden, Cro
 pub fn compare_walk(root: &Path, json_path: &Path) -> Result<WalkComparison, CrosscheckError> {
     let g = read_walk_golden(root, json_path)?;
     let project = simulate_walk(&g.design, &g.options)?.report;
+    let approximation = g
+        .meta
+        .engine
+        .as_ref()
+        .and_then(|e| e.discrete_contact_approximation.clone());
+    // The harness's default approximation is SAP (convex); only `lagged` and `tamsi`
+    // keep Coulomb friction.
+    let convex = !matches!(approximation.as_deref(), Some("lagged") | Some("tamsi"));
+    let project_convex = if convex {
+        let mut d = g.design.clone();
+        d.contact.friction_cone = FrictionCone::Convex;
+        Some(simulate_walk(&d, &g.options)?.report)
+    } else {
+        None
+    };
     Ok(WalkComparison {
         name: json_path
             .file_stem()
             .map(|s| s.to_string_lossy().into_owned())
             .unwrap_or_default(),
         design: g.meta.design_file,
-        drake_approximation: g.meta.engine.and_then(|e| e.discrete_contact_approximation),
+        drake_approximation: approximation,
         leg_length_m: project.leg_length_m,
         drive_frequency_hz: project.drive_frequency_hz,
         project,
+        project_convex,
         drake: g.drake,
     })
 }
@@ -775,6 +805,8 @@ pub struct QuantityRow {
     pub case: String,
     pub quantity: String,
     pub project: Option<f64>,
+    /// The project with the convex friction cone ([`with_convex_cone`]).
+    pub project_convex: Option<f64>,
     pub drake: Option<f64>,
     pub analytic: Option<f64>,
 }
@@ -782,10 +814,19 @@ pub struct QuantityRow {
 impl QuantityRow {
     /// (project − Drake)/|Drake|.
     pub fn relative_difference(&self) -> Option<f64> {
-        match (self.project, self.drake) {
-            (Some(p), Some(d)) if d != 0.0 => Some((p - d) / d.abs()),
-            _ => None,
-        }
+        relative(self.project, self.drake)
+    }
+
+    /// (project with the convex cone − Drake)/|Drake|.
+    pub fn convex_relative_difference(&self) -> Option<f64> {
+        relative(self.project_convex, self.drake)
+    }
+}
+
+fn relative(ours: Option<f64>, drake: Option<f64>) -> Option<f64> {
+    match (ours, drake) {
+        (Some(p), Some(d)) if d != 0.0 => Some((p - d) / d.abs()),
+        _ => None,
     }
 }
 
@@ -824,12 +865,14 @@ pub fn run(
     for (name, case) in &cases {
         progress.stage(&format!("running {name}"));
         let ours = run_case(root, name, case)?;
+        let convex = run_case(root, name, &with_convex_cone(case))?;
         let theirs = &drake["cases"][name.as_str()];
         for (q, v) in &ours {
             rows.push(QuantityRow {
                 case: name.clone(),
                 quantity: q.clone(),
                 project: *v,
+                project_convex: convex.get(q).copied().flatten(),
                 drake: number(theirs["measured"].get(q)),
                 analytic: number(theirs["analytic"].get(q)),
             });

@@ -112,6 +112,11 @@ pub struct BenchmarkOptions {
     /// `trials-none.csv` ([`super::reference`]); written into the signature only when on.
     #[serde(default, skip_serializing_if = "std::ops::Not::not")]
     pub drake_reference: bool,
+    /// The nominal model the Drake cases are diagnosed against, in place of their files'
+    /// `design` (e.g. `mugatu-ref-sap`, the reference with SAP's convex friction cone, for
+    /// trials Drake-SAP made from `mugatu-ref`); written into the signature only when set.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub drake_design: Option<String>,
 }
 
 fn is_zero(n: &u64) -> bool {
@@ -151,6 +156,7 @@ impl BenchmarkOptions {
             audit_partners: 0,
             model_spread_seeds: 0,
             drake_reference: false,
+            drake_design: None,
         }
     }
 }
@@ -824,7 +830,12 @@ fn drake_cases(
         });
     }
     for f in files {
-        let set = TrialSet::read(&f)?;
+        let mut set = TrialSet::read(&f)?;
+        if let Some(d) = &opts.drake_design {
+            for t in set.trials.iter_mut() {
+                t.design = d.clone();
+            }
+        }
         let name = f
             .file_stem()
             .and_then(|s| s.to_str())

@@ -82,10 +82,14 @@ fn resolve_trial(t: &Trial, origin: &str, base: &Path) -> Result<Condition, GapE
         Err(crate::sim::SimError::UnknownDesign(_)) => {
             let p = base.join(&t.design);
             if !p.exists() {
+                let bundled: Vec<&str> = crate::sim::BUILTIN_DESIGNS
+                    .iter()
+                    .map(|(n, _, _)| *n)
+                    .collect();
                 return Err(at(format!(
-                    "design {:?} is neither a bundled design (mugatu, zippy, zippy-spherical, \
-                     mugatu-ref, zippy-ref, zippy-spherical-ref) nor a file {}",
+                    "design {:?} is neither a bundled design ({}) nor a file {}",
                     t.design,
+                    bundled.join(", "),
                     p.display()
                 )));
             }

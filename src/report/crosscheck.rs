@@ -24,16 +24,19 @@ pub fn crosscheck_md(c: &Crosscheck) -> String {
         "Drake {}; project: this build. Walks: both trajectories measured by the project's gait metrics.\n\n",
         c.drake_version.as_deref().unwrap_or("(no goldens found)")
     ));
-    out.push_str("| case | quantity | project | Drake | analytic | project − Drake |\n|---|---|---|---|---|---|\n");
+    out.push_str("Project (convex): the same case with `contact.friction_cone = \"convex\"`, the friction relaxation of Drake's SAP.\n\n");
+    out.push_str("| case | quantity | project | project (convex) | Drake | analytic | project − Drake | convex − Drake |\n|---|---|---|---|---|---|---|---|\n");
     for r in &c.elementary {
         out.push_str(&format!(
-            "| {} | {} | {} | {} | {} | {} |\n",
+            "| {} | {} | {} | {} | {} | {} | {} | {} |\n",
             r.case,
             r.quantity,
             cell(r.project),
+            cell(r.project_convex),
             cell(r.drake),
             cell(r.analytic),
-            pct(r.relative_difference())
+            pct(r.relative_difference()),
+            pct(r.convex_relative_difference())
         ));
     }
     out.push_str("\n| walk | engine | walks | v [m/s] | step f [Hz] | roll p-p [°] | pitch p-p [°] | yaw p-p [°] |\n|---|---|---|---|---|---|---|---|\n");
@@ -42,7 +45,12 @@ pub fn crosscheck_md(c: &Crosscheck) -> String {
             Some(a) => format!("Drake ({a})"),
             None => "Drake".to_string(),
         };
-        for (engine, r) in [("project", &w.project), (drake.as_str(), &w.drake)] {
+        let mut engines = vec![("project", &w.project)];
+        if let Some(r) = &w.project_convex {
+            engines.push(("project (convex)", r));
+        }
+        engines.push((drake.as_str(), &w.drake));
+        for (engine, r) in engines {
             out.push_str(&format!(
                 "| {} | {} | {} | {} | {} | {} ± {} | {} ± {} | {} ± {} |\n",
                 w.name,

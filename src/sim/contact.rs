@@ -70,6 +70,15 @@ pub struct ContactParams {
     pub stiction_speed_mps: f64,
     /// Kelvin–Voigt relaxation time τ_d [s] (Drake SAP's `relaxation_time`; 0: none).
     pub relaxation_time_s: f64,
+    /// Convex-cone coupling time t_c [s] (0: physical Coulomb friction). With t_c > 0 the
+    /// contact works as Drake's SAP does (an engine's artefact, not physics): each patch
+    /// point's pressure reacts to vₙ − μ·s instead of vₙ, s the point's slip speed
+    /// (regularised, 0 at rest), through the coefficient p_e·d + g·t_c — the pressure
+    /// then rises while the point slides and the foot lifts off at about μ·s, as a
+    /// convex (Anitescu) relaxation of the friction cone makes it. `Design::model` sets
+    /// t_c = τ_d + δt for `friction_cone = "convex"`.
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub convex_coupling_time_s: f64,
     /// Rolling-resistance length e [m]: the centre of pressure shifts this far ahead of
     /// the rolling direction (0: none; the `rolling_resistance` effect sets it).
     #[serde(default)]
@@ -78,6 +87,10 @@ pub struct ContactParams {
     /// viscous, as friction below the stiction speed (`Design::model`: v_s/L).
     #[serde(default)]
     pub rolling_resistance_rate_rad_s: f64,
+}
+
+fn is_zero(x: &f64) -> bool {
+    *x == 0.0
 }
 
 /// Radial Gauss–Legendre nodes/weights on ξ ∈ [0, 1] (3 points).
@@ -608,6 +621,12 @@ pub struct PatchWrench {
     pub friction_damping: Matrix3<f64>,
     /// −∂M/∂ω of the rolling-resistance moment (symmetric PSD).
     pub rolling_damping: Matrix3<f64>,
+    /// ∂Fₙ/∂(v_x, v_y, ω_z) of the convex cone's lift (zero with Coulomb friction): the
+    /// step makes the lift implicit in the slip, as SAP's cone projection is, so a foot
+    /// slowed by friction within a step is lifted by its slip at the step's end. Taken at
+    /// the start of the step it lifted a sliding foot at μ·(its slip before friction), and
+    /// the slide case hopped 2.5× higher than Drake's.
+    pub lift_slip_gradient: Vector3<f64>,
 }
 
 /// Forces on the patch given the velocity `v_cop` of the foot's material point at the
@@ -618,7 +637,7 @@ pub fn patch_wrench(
     v_cop: &Vector3<f64>,
     omega: &Vector3<f64>,
 ) -> PatchWrench {
-    if params.relaxation_time_s > 0.0 {
+    if params.relaxation_time_s > 0.0 || params.convex_coupling_time_s > 0.0 {
         return patch_wrench_pointwise(p, params, v_cop, omega);
     }
     let d = params.dissipation_s_per_m;
@@ -692,6 +711,7 @@ fn with_friction(
         normal_damping: 0.0,
         friction_damping,
         rolling_damping: Matrix3::zeros(),
+        lift_slip_gradient: Vector3::zeros(),
     }
 }
 
@@ -716,6 +736,7 @@ fn patch_wrench_pointwise(
 ) -> PatchWrench {
     let d = params.dissipation_s_per_m;
     let kv = params.relaxation_time_s * p.pressure_gradient_pa_per_m;
+    let g_n = p.pressure_gradient_pa_per_m;
     let n = p.quad_len;
     // Elastic force and centre of pressure are the closed form's; the quadrature's elastic
     // pressures are rescaled to it so that at rest both paths agree exactly.
@@ -732,16 +753,34 @@ fn patch_wrench_pointwise(
     let (mut fz, mut mx, mut my) = (0.0, 0.0, 0.0);
     let mut normal_damping = 0.0;
     let (mut cxx, mut cxy, mut cyy) = (0.0, 0.0, 0.0);
+    let mut lift_slip_gradient = Vector3::zeros();
+    let tc = params.convex_coupling_time_s;
+    let mu = params.friction_mu;
+    let vs = params.stiction_speed_mps;
     for (i, w) in weights.iter_mut().enumerate().take(n) {
         let off = p.quad_offsets[i];
         let area = p.quad_area_m2[i];
         let pe = p.quad_pressure_pa[i] * scale;
         let vn = v_cop.z + g.dot(&off);
         let slope = pe * d + kv;
-        let pi = pe - slope * vn;
+        let mut pi = pe - slope * vn;
+        let mut lift = Vector3::zeros();
+        if tc > 0.0 {
+            // The convex cone's lift: the point's slip speed (as the friction sees it,
+            // spin included), regularised like the friction so it is smooth and 0 at rest.
+            let vx = v_cop.x - off.y * omega.z;
+            let vy = v_cop.y + off.x * omega.z;
+            let r = (vx * vx + vy * vy + vs * vs).sqrt();
+            let c = (pe * d + g_n * tc) * mu;
+            pi += c * (r - vs);
+            // ∂(c·slip)/∂(v_x, v_y, ω_z), slip's gradient being its direction û.
+            let (ux, uy) = (vx / r, vy / r);
+            lift = Vector3::new(ux, uy, -ux * off.y + uy * off.x) * c;
+        }
         if pi <= 0.0 {
             continue;
         }
+        lift_slip_gradient += lift * area;
         let f = pi * area;
         *w = f;
         fz += f;
@@ -765,8 +804,10 @@ fn patch_wrench_pointwise(
     }
     let mut moment = Vector3::new(mx, my, 0.0);
     add_rolling_resistance(p, params, fz, omega, &mut moment, &mut rolling_damping);
-    with_friction(p, &weights[..n], params, fz, v_cop, omega, moment)
-        .damped(normal_damping, rolling_damping)
+    let mut w = with_friction(p, &weights[..n], params, fz, v_cop, omega, moment)
+        .damped(normal_damping, rolling_damping);
+    w.lift_slip_gradient = lift_slip_gradient;
+    w
 }
 
 /// Adds the rolling-resistance moment of the `rolling_resistance` effect: the centre of

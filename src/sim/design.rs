@@ -18,7 +18,7 @@ use super::state::State;
 /// Built-in designs: (name, path in the repository, text). Bundled so the binary works
 /// from any directory. The `-ref` designs are ../shared/research/walker-models.json in this
 /// schema: the models of the Drake cross-check (reports/drake-crosscheck.md).
-pub const BUILTIN_DESIGNS: [(&str, &str, &str); 6] = [
+pub const BUILTIN_DESIGNS: [(&str, &str, &str); 7] = [
     (
         "mugatu",
         "dataset/walkers/mugatu.toml",
@@ -38,6 +38,11 @@ pub const BUILTIN_DESIGNS: [(&str, &str, &str); 6] = [
         "mugatu-ref",
         "dataset/walkers/reference/mugatu-ref.toml",
         include_str!("../../dataset/walkers/reference/mugatu-ref.toml"),
+    ),
+    (
+        "mugatu-ref-sap",
+        "dataset/walkers/reference/mugatu-ref-sap.toml",
+        include_str!("../../dataset/walkers/reference/mugatu-ref-sap.toml"),
     ),
     (
         "zippy-ref",
@@ -97,6 +102,31 @@ pub struct ContactSpec {
     /// pressure −τ_d·(E/ρₙ)·vₙ over the whole patch); absent: 0 (Hunt–Crossley only).
     #[serde(default)]
     pub relaxation_time_s: f64,
+    /// The friction cone the contact solver works with; absent: `coulomb`. Not written
+    /// when `coulomb`, so a design's serialised form (and every key made from it) is the
+    /// same as before the field existed.
+    #[serde(default, skip_serializing_if = "FrictionCone::is_coulomb")]
+    pub friction_cone: FrictionCone,
+}
+
+/// How the contact solver treats friction (see [`ContactParams::convex_coupling_time_s`]).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum FrictionCone {
+    /// Physical Coulomb friction: the normal force does not depend on the slip (the
+    /// project's model, and Drake's `lagged` approximation).
+    #[default]
+    Coulomb,
+    /// The convex (Anitescu-type) relaxation of Drake's SAP and `similar` approximations:
+    /// a sliding contact pushes its bodies apart at μ·|slip|, so a scuffing foot glides.
+    /// An engine's artefact, offered to model that engine's trials, not a robot.
+    Convex,
+}
+
+impl FrictionCone {
+    pub fn is_coulomb(&self) -> bool {
+        *self == FrictionCone::Coulomb
+    }
 }
 
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -1064,6 +1094,13 @@ impl Design {
             friction_mu: self.contact.friction_mu,
             stiction_speed_mps: self.contact.stiction_speed_mps,
             relaxation_time_s: self.contact.relaxation_time_s,
+            // SAP's normal impulse reacts to vₙ − μ|v_t| through its whole implicit normal
+            // coefficient k·(δt + τ) (Castro et al. 2022, the cone projection's sliding
+            // branch with R_t ≪ R_n), so the coupling time is τ + δt.
+            convex_coupling_time_s: match self.contact.friction_cone {
+                FrictionCone::Coulomb => 0.0,
+                FrictionCone::Convex => self.contact.relaxation_time_s + self.numerics.time_step_s,
+            },
             rolling_resistance_m: 0.0,
             // The angular counterpart of the stiction speed: a foot rolling on its leg
             // (radius ~ L) at v_s.

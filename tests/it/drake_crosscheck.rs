@@ -392,17 +392,99 @@ fn project_walk_agrees_with_drake_lagged_on_the_same_model() {
     }
 }
 
-/// Known gap, kept as an executable check: the reference Mugatu at 1.4 Hz against Drake's
-/// SAP (convex friction), the criterion (speed and attitudes within 25 %). It
-/// fails because SAP's convex friction lets the scuffing feet glide (see the two tests
-/// above and reports/drake-crosscheck.md); the project keeps physical Coulomb friction.
+/// The reference Mugatu against Drake's SAP with the project's convex friction cone
+/// (`friction_cone = "convex"`, SAP's relaxation: a sliding contact is pushed apart at
+/// μ·|slip|), the criterion for walks: speed and attitudes within 25 %. With
+/// Coulomb friction the project scuffs in place at 1.4 Hz (roll 66°, pitch 90°) where SAP
+/// walks; with the convex cone both walk. Measured: 1.4 Hz |v| 0.165 vs 0.165 m/s, roll
+/// 11.1 vs 11.8°, pitch 12.0 vs 12.3°, yaw 16.0 vs 16.1°; the scaled walks (0.5×, 2×) and
+/// the −3° start within 13 %. The speed's sign is not compared: the fore–aft-symmetric
+/// rocker's direction is set by its first cycles, and Drake itself walks this model
+/// forward or backward with the relaxation time (reports/drake-crosscheck.md).
 #[test]
-#[ignore = "known gap: Drake-SAP's convex friction lets sliding feet glide; the project's friction does not"]
-fn reference_walk_within_25_percent_of_drake_sap() {
-    let w = walk("mugatu-ref-1x-f1.4");
-    let (p, d) = (&w.project, &w.drake);
-    assert!(within(p.velocity_mps.abs(), d.velocity_mps.abs(), 0.25));
-    assert!(within(p.roll_pp_deg, d.roll_pp_deg, 0.25));
-    assert!(within(p.pitch_pp_deg, d.pitch_pp_deg, 0.25));
-    assert!(within(p.yaw_pp_deg, d.yaw_pp_deg, 0.25));
+fn reference_walk_within_25_percent_of_drake_sap_with_the_convex_cone() {
+    for stem in [
+        "mugatu-ref-1x-f1.4",
+        "mugatu-ref-1x-f1.4-roll-minus3",
+        "mugatu-ref-L0.05",
+        "mugatu-ref-L0.5",
+    ] {
+        let w = walk(stem);
+        assert_eq!(w.drake_approximation.as_deref(), Some("sap"), "{stem}");
+        let p = w
+            .project_convex
+            .as_ref()
+            .expect("a SAP golden has a convex run");
+        let d = &w.drake;
+        let sqrt_gl = (9.81 * w.leg_length_m).sqrt();
+        assert!(
+            p.velocity_mps.abs() > 0.1 * sqrt_gl && d.velocity_mps.abs() > 0.1 * sqrt_gl,
+            "{stem}: both walk: {p:?} / {d:?}"
+        );
+        for (name, a, b) in [
+            ("|v|", p.velocity_mps.abs(), d.velocity_mps.abs()),
+            ("roll", p.roll_pp_deg, d.roll_pp_deg),
+            ("pitch", p.pitch_pp_deg, d.pitch_pp_deg),
+            ("yaw", p.yaw_pp_deg, d.yaw_pp_deg),
+            ("step frequency", p.step_frequency_hz, d.step_frequency_hz),
+        ] {
+            assert!(within(a, b, 0.25), "{stem} {name}: convex {a} vs SAP {b}");
+        }
+        // With Coulomb friction the 1× walks scuff in place instead (the gap this closes).
+        if stem == "mugatu-ref-1x-f1.4" {
+            assert!(
+                w.project.velocity_mps.abs() < 0.1 * sqrt_gl,
+                "{:?}",
+                w.project
+            );
+            assert!(
+                w.project.roll_pp_deg > 3.0 * d.roll_pp_deg,
+                "{:?}",
+                w.project
+            );
+        }
+    }
+}
+
+/// The convex cone on the slide case (a flat foot sliding at 0.5 m/s): like Drake's SAP
+/// and unlike Coulomb friction, the sliding foot is lifted off the ground for most of the
+/// slide, in hops of millimetres. Drake: airborne 86 % of the slide, hops of 2.19 mm,
+/// velocity line-fit deceleration 4.08 m/s²; project (convex): 80 %, 2.83 mm, 4.33 m/s²
+/// (tolerances 0.1, 50 %, 15 %). Known difference, asserted as a bound: the project's
+/// foot stops 43 % farther (22.3 vs 15.5 mm; SAP stops at the Coulomb distance, as rigid
+/// Anitescu contact predicts for this case). The project solves the cone by a linearly
+/// implicit step with friction rescaled to the step's normal force (4 passes), not by
+/// SAP's convex optimisation, and its hops land harder.
+#[test]
+fn convex_cone_lifts_a_sliding_foot_as_drake_sap_does() {
+    let d = drake();
+    let case = crosscheck::with_convex_cone(&cases()["slide"]);
+    let m = crosscheck::run_case(&common::repo(), "slide", &case).expect("case runs");
+    let air = get(&m, "airborne_fraction_while_sliding");
+    let sap_air = drake_measured(&d, "slide", "airborne_fraction_while_sliding");
+    assert!(
+        (air - sap_air).abs() < 0.1,
+        "airborne {air} vs SAP {sap_air}"
+    );
+    let hop = get(&m, "max_hop_height_m");
+    let sap_hop = drake_measured(&d, "slide", "max_hop_height_m");
+    assert!(rel(hop, sap_hop) < 0.5, "hop {hop} vs SAP {sap_hop}");
+    let fit = get(&m, "deceleration_linefit_mps2");
+    let sap_fit = drake_measured(&d, "slide", "deceleration_linefit_mps2");
+    assert!(rel(fit, sap_fit) < 0.15, "line fit {fit} vs SAP {sap_fit}");
+    let dist = get(&m, "stopping_distance_m");
+    let sap_dist = drake_measured(&d, "slide", "stopping_distance_m");
+    assert!(
+        dist > sap_dist && dist < 1.6 * sap_dist,
+        "distance {dist} vs SAP {sap_dist}"
+    );
+    // The cone changes nothing where nothing slides: the sinkage case is Coulomb's.
+    let still = crosscheck::run_case(
+        &common::repo(),
+        "sinkage_sphere",
+        &crosscheck::with_convex_cone(&cases()["sinkage_sphere"]),
+    )
+    .expect("case runs");
+    let coulomb = ours("sinkage_sphere");
+    assert!(rel(get(&still, "sinkage_m"), get(&coulomb, "sinkage_m")) < 1e-6);
 }

@@ -22,6 +22,7 @@ fn contact(modulus_pa: f64, friction_mu: f64) -> ContactParams {
         friction_mu,
         stiction_speed_mps: 1e-4,
         relaxation_time_s: 0.0,
+        convex_coupling_time_s: 0.0,
         rolling_resistance_m: 0.0,
         rolling_resistance_rate_rad_s: 0.0,
     }

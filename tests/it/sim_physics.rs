@@ -56,6 +56,7 @@ fn frictionless(modulus_pa: f64) -> ContactParams {
         friction_mu: 0.0,
         stiction_speed_mps: 1e-3,
         relaxation_time_s: 0.0,
+        convex_coupling_time_s: 0.0,
         rolling_resistance_m: 0.0,
         rolling_resistance_rate_rad_s: 0.0,
     }
@@ -164,6 +165,7 @@ fn rocking_frequency_on_spherical_foot() {
         friction_mu: 1.0,
         stiction_speed_mps: 1e-4,
         relaxation_time_s: 0.0,
+        convex_coupling_time_s: 0.0,
         rolling_resistance_m: 0.0,
         rolling_resistance_rate_rad_s: 0.0,
     });
@@ -221,6 +223,7 @@ fn sphere_rolls_down_incline_at_five_sevenths_g_sin_theta() {
         friction_mu: 1.0,
         stiction_speed_mps: 1e-4,
         relaxation_time_s: 0.0,
+        convex_coupling_time_s: 0.0,
         rolling_resistance_m: 0.0,
         rolling_resistance_rate_rad_s: 0.0,
     };
@@ -422,6 +425,7 @@ fn static_penetration_matches_contact_law() {
         friction_mu: 0.8,
         stiction_speed_mps: 1e-3,
         relaxation_time_s: 0.0,
+        convex_coupling_time_s: 0.0,
         rolling_resistance_m: 0.0,
         rolling_resistance_rate_rad_s: 0.0,
     };
@@ -553,6 +557,7 @@ fn kelvin_voigt_bounce_decays_as_a_linear_damper() {
         friction_mu: 0.0,
         stiction_speed_mps: 1e-4,
         relaxation_time_s: tau,
+        convex_coupling_time_s: 0.0,
         rolling_resistance_m: 0.0,
         rolling_resistance_rate_rad_s: 0.0,
     };
@@ -615,6 +620,7 @@ fn kelvin_voigt_rocking_decay_matches_rolling_resistance() {
         friction_mu: 1.0,
         stiction_speed_mps: 1e-4,
         relaxation_time_s: tau,
+        convex_coupling_time_s: 0.0,
         rolling_resistance_m: 0.0,
         rolling_resistance_rate_rad_s: 0.0,
     });
