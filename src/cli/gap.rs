@@ -931,6 +931,32 @@ fn explore(a: &ExploreArgs) -> anyhow::Result<ExitCode> {
     Ok(ExitCode::SUCCESS)
 }
 
+/// Where two specification lines part: a few characters of each from the first difference.
+fn first_difference(files: &str, these: &str) -> String {
+    let at = files
+        .char_indices()
+        .zip(these.chars())
+        .find(|((_, a), b)| a != b)
+        .map_or(files.len().min(these.len()), |((i, _), _)| i);
+    let start = files[..at]
+        .char_indices()
+        .rev()
+        .nth(40)
+        .map_or(0, |(i, _)| i);
+    let excerpt = |s: &str| {
+        s.get(start..)
+            .unwrap_or("")
+            .chars()
+            .take(120)
+            .collect::<String>()
+    };
+    format!(
+        "the files say …{}…, these options …{}…",
+        excerpt(files),
+        excerpt(these)
+    )
+}
+
 fn benchmark(a: &BenchmarkArgs) -> anyhow::Result<ExitCode> {
     use robot_survey::checkpoint::Shard;
     let lib = EffectLibrary::bundled()?;
@@ -1024,9 +1050,11 @@ fn benchmark(a: &BenchmarkArgs) -> anyhow::Result<ExitCode> {
             anyhow::bail!("--merge needs --points FILE (the merged file)");
         };
         let (header, rows) = robot_survey::checkpoint::merge::<gap::benchmark::CaseRow>(&a.merge)?;
-        if header != gap::benchmark::spec(&opts) {
+        let expected = gap::benchmark::spec(&opts);
+        if header != expected {
             anyhow::bail!(
-                "the merged files were written with other benchmark options than these; merge with the options of the run"
+                "the merged files were written with other benchmark options than these; merge with the options of the run ({})",
+                first_difference(&header, &expected)
             );
         }
         robot_survey::checkpoint::finish_points(target, &header, &rows)?;
