@@ -82,15 +82,18 @@ drake_reference() {
 }
 for name in lagged lagged-next lagged-heldout; do drake_reference "$name"; done
 # Drake-SAP's trials against mugatu-ref-sap (the convex friction cone), plain and through the
-# no-effect trials (eighteenth session).
-for ref in "" "--drake-reference"; do
-  r="gap-benchmark-drake-sap-convex${ref:+-reference}"
-  "$S" gap benchmark --design mugatu --quick --noise 0.03,0.05 --null-cases 300 --one-robot-nulls 300 \
-    --drake tests/golden/drake/gap --drake-design mugatu-ref-sap $ref \
-    --merge "reports/$r.points.csv" --points "$T/$r.points.csv" --out "$T/$r" >/dev/null 2>&1
-  prefix "$T/$r/gap-benchmark.md" "$r/gap-benchmark.md"
-  same "$T/$r/gap-benchmark.json" "$r/gap-benchmark.json"
-  same "$T/$r/gap-benchmark.svg" "$r/gap-benchmark.svg"
+# no-effect trials: with the signed velocity (eighteenth session) and compared on speed
+# (criteria.walking_direction = "either"; nineteenth session, four of the nine files).
+for run in convex speed; do
+  for ref in "" "--drake-reference"; do
+    r="gap-benchmark-drake-sap-$run${ref:+-reference}"
+    "$S" gap benchmark --design mugatu --quick --noise 0.03,0.05 --null-cases 300 --one-robot-nulls 300 \
+      --drake tests/golden/drake/gap --drake-design mugatu-ref-sap $ref \
+      --merge "reports/$r.points.csv" --points "$T/$r.points.csv" --out "$T/$r" >/dev/null 2>&1
+    prefix "$T/$r/gap-benchmark.md" "$r/gap-benchmark.md"
+    same "$T/$r/gap-benchmark.json" "$r/gap-benchmark.json"
+    same "$T/$r/gap-benchmark.svg" "$r/gap-benchmark.svg"
+  done
 done
 echo "$fails report(s) differ"
 [ "$fails" -eq 0 ]

@@ -573,9 +573,42 @@ pub struct BenchmarkArgs {
     /// Applied after --kinds; an empty selection is an error.
     #[arg(long, value_delimiter = ',', value_name = "TEXT")]
     pub keys: Vec<String>,
-    /// Folder for gap-benchmark.md, .json and .svg.
-    #[arg(long, value_name = "DIR", default_value = "reports")]
-    pub out: PathBuf,
+    /// Folder for gap-benchmark.md, .json and .svg [default: reports]. A narrowed run
+    /// (--kinds, --keys, --drake-design, --drake-reference) needs it given: its report is not
+    /// the committed reports/gap-benchmark.md and must not overwrite it unasked.
+    #[arg(long, value_name = "DIR")]
+    pub out: Option<PathBuf>,
+}
+
+impl BenchmarkArgs {
+    /// The report folder: --out, or reports/ for a run of the whole benchmark; an error
+    /// for a narrowed run without --out.
+    fn out_dir(&self) -> anyhow::Result<PathBuf> {
+        if let Some(out) = &self.out {
+            return Ok(out.clone());
+        }
+        let mut narrowing = Vec::new();
+        if !self.kinds.is_empty() {
+            narrowing.push("--kinds");
+        }
+        if !self.keys.is_empty() {
+            narrowing.push("--keys");
+        }
+        if self.drake_design.is_some() {
+            narrowing.push("--drake-design");
+        }
+        if self.drake_reference {
+            narrowing.push("--drake-reference");
+        }
+        if narrowing.is_empty() {
+            return Ok(PathBuf::from("reports"));
+        }
+        anyhow::bail!(
+            "{} narrow the benchmark: its report would overwrite reports/gap-benchmark.{{md,json,svg}}; \
+             give --out DIR (--out reports to mean it)",
+            narrowing.join(", ")
+        )
+    }
 }
 
 pub fn run(a: &GapArgs) -> anyhow::Result<ExitCode> {
@@ -959,6 +992,7 @@ fn first_difference(files: &str, these: &str) -> String {
 
 fn benchmark(a: &BenchmarkArgs) -> anyhow::Result<ExitCode> {
     use robot_survey::checkpoint::Shard;
+    let out = a.out_dir()?;
     let lib = EffectLibrary::bundled()?;
     let mut opts = match &a.cases {
         Some(file) => gap::benchmark::BenchmarkOptions::with_cases(
@@ -1108,15 +1142,15 @@ fn benchmark(a: &BenchmarkArgs) -> anyhow::Result<ExitCode> {
     if a.drake_reference {
         command.push_str(" --drake-reference");
     }
-    std::fs::create_dir_all(&a.out)?;
+    std::fs::create_dir_all(&out)?;
     let md = report::gap::benchmark_md(&summary, &rows, &command);
-    write_atomic(&a.out.join("gap-benchmark.md"), md.as_bytes())?;
+    write_atomic(&out.join("gap-benchmark.md"), md.as_bytes())?;
     write_atomic(
-        &a.out.join("gap-benchmark.json"),
+        &out.join("gap-benchmark.json"),
         report::json(&serde_json::json!({ "summary": summary, "cases": rows }))?.as_bytes(),
     )?;
-    report::gap::confusion_plot(&summary, &a.out.join("gap-benchmark.svg"))?;
-    eprintln!("wrote {}/gap-benchmark.{{md,json,svg}}", a.out.display());
+    report::gap::confusion_plot(&summary, &out.join("gap-benchmark.svg"))?;
+    eprintln!("wrote {}/gap-benchmark.{{md,json,svg}}", out.display());
     print(&md);
     Ok(ExitCode::SUCCESS)
 }

@@ -228,8 +228,26 @@ pub struct Timing {
 }
 
 /// Trials whose `trajectory` file is given get the metrics they lack measured from it, by
-/// the code that measures the simulator's walks (`sim::report_from_trajectory`).
+/// the code that measures the simulator's walks (`sim::report_from_trajectory`); at a
+/// condition whose direction the start sets ([`Condition::direction_free`]) the measured
+/// velocity becomes a speed |v|, as the simulated one is.
 fn fill_from_trajectories(
+    set: &TrialSet,
+    conditions: &[Condition],
+    lib: &EffectLibrary,
+) -> Result<TrialSet, GapError> {
+    let mut out = fill_metrics_from_trajectories(set, conditions, lib)?;
+    for (t, c) in out.trials.iter_mut().zip(conditions) {
+        if c.direction_free()
+            && let Some(v) = &mut t.measured[Metric::VelocityMps.index()]
+        {
+            v.value = v.value.abs();
+        }
+    }
+    Ok(out)
+}
+
+fn fill_metrics_from_trajectories(
     set: &TrialSet,
     conditions: &[Condition],
     lib: &EffectLibrary,

@@ -207,6 +207,15 @@ impl Condition {
             })
     }
 
+    /// Whether the condition's walking direction is set by the walker's start, not by the
+    /// model: its design walks either way ([`crate::sim::WalkingDirection::Either`]) and the
+    /// condition sets no slope. Its velocity is then compared as a speed |v|, simulated and
+    /// measured alike.
+    pub fn direction_free(&self) -> bool {
+        !self.design.criteria.walking_direction.is_forward()
+            && self.slope_deg.is_none_or(|s| s == 0.0)
+    }
+
     /// The drive frequency the condition runs at: its own, or the design's scaled to its size.
     pub fn drive_frequency_hz(&self) -> Result<f64, GapError> {
         if let Some(f) = self.frequency_hz {
@@ -271,6 +280,10 @@ impl Condition {
         if !fell {
             for m in Metric::SIMULATED {
                 values[m.index()] = m.of_report(&r.report);
+            }
+            if self.direction_free() {
+                let v = &mut values[Metric::VelocityMps.index()];
+                *v = v.abs();
             }
         }
         Ok((SimMetrics { values, fell }, r.trajectory))

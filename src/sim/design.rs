@@ -186,6 +186,33 @@ pub struct CriteriaSpec {
     pub fall_roll_deg: f64,
     /// Fallen if |pitch| of the hip frame exceeds this [deg].
     pub fall_pitch_deg: f64,
+    /// Whether the sign of the walking velocity is a prediction of the model (`forward`, the
+    /// default) or set by the walker's first steps (`either`; see [`WalkingDirection`]).
+    #[serde(default, skip_serializing_if = "WalkingDirection::is_forward")]
+    pub walking_direction: WalkingDirection,
+}
+
+/// Which way a design walks.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum WalkingDirection {
+    /// The model predicts the direction: a backward walk is a negative velocity.
+    #[default]
+    Forward,
+    /// A fore–aft symmetric design (feet and leg COMs centred fore–aft, on the flat): the
+    /// mirror image of a gait is a gait of the same drive half a period later, the free roll
+    /// locks to the drive in either phase, and which of the two the walker takes is set by
+    /// its first cycles — in both engines a few per cent of μ or of the drive frequency flip
+    /// it (reports/gap-benchmark-drake-sap-convex/). The velocity is then compared as a
+    /// speed |v| (the gap diagnosis, the walking criterion); on a sloped condition the
+    /// slope sets the direction and the signed velocity is kept.
+    Either,
+}
+
+impl WalkingDirection {
+    pub fn is_forward(&self) -> bool {
+        *self == WalkingDirection::Forward
+    }
 }
 
 impl CriteriaSpec {
@@ -413,6 +440,7 @@ impl Design {
         })?;
         d.validate(origin)?;
         d.check_uncertain(origin)?;
+        d.check_direction(origin)?;
         Ok(d)
     }
 
@@ -455,6 +483,36 @@ impl Design {
             }
             Err(e) => Err(e),
         }
+    }
+
+    /// A design that walks either way must be fore–aft symmetric as written (checked where
+    /// a file is read, not on calibrated copies: a knob may move a COM or the slope off the
+    /// symmetry, and is then judged on the speed it gives).
+    fn check_direction(&self, origin: &str) -> Result<(), SimError> {
+        if self.criteria.walking_direction.is_forward() {
+            return Ok(());
+        }
+        let ck = FieldCheck { origin };
+        let why =
+            "must be 0 for criteria.walking_direction = \"either\" (a fore–aft symmetric design)";
+        ck.check(
+            "geometry.foot_center_forward_over_l",
+            self.geometry.foot_center_forward_over_l,
+            self.geometry.foot_center_forward_over_l == 0.0,
+            why,
+        )?;
+        ck.check(
+            "mass.leg_com_forward_over_l",
+            self.mass.leg_com_forward_over_l,
+            self.mass.leg_com_forward_over_l == 0.0,
+            why,
+        )?;
+        ck.check(
+            "ground.slope_deg",
+            self.ground.slope_deg,
+            self.ground.slope_deg == 0.0,
+            why,
+        )
     }
 
     fn validate(&self, origin: &str) -> Result<(), SimError> {

@@ -712,7 +712,13 @@ fn analyze(
         .iter()
         .map(|s| s.peak_abs_torque_nm)
         .fold(0.0, f64::max);
-    r.walks = r.velocity_mps > d.criteria.walk_speed_threshold_mps(l);
+    // A design that walks either way (fore–aft symmetric) walks backward as well as forward.
+    let speed = if d.criteria.walking_direction.is_forward() {
+        r.velocity_mps
+    } else {
+        r.velocity_mps.abs()
+    };
+    r.walks = speed > d.criteria.walk_speed_threshold_mps(l);
     r
 }
 

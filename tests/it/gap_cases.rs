@@ -175,3 +175,32 @@ fn the_benchmark_refuses_a_bad_cases_file_by_name() {
     );
     assert_eq!(e.matches("no field `kp_over_mgl`").count(), 1, "{e}");
 }
+
+/// A narrowed benchmark run (here `--kinds drake --drake-design …`) without `--out` is refused
+/// before any case runs, naming the narrowing flags: its report would otherwise replace the
+/// committed reports/gap-benchmark.{md,json,svg} (it once did).
+#[test]
+fn a_narrowed_benchmark_needs_an_out_folder() {
+    let report = repo().join("reports/gap-benchmark.md");
+    let before = std::fs::read_to_string(&report).expect("committed report");
+    let out = survey(&[
+        "gap",
+        "benchmark",
+        "--design",
+        "mugatu",
+        "--quick",
+        "--drake",
+        "tests/golden/drake/gap",
+        "--kinds",
+        "drake",
+        "--drake-design",
+        "mugatu-ref-sap",
+    ]);
+    assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
+    let e = stderr(&out);
+    assert!(
+        e.contains("--kinds, --drake-design") && e.contains("--out DIR"),
+        "{e}"
+    );
+    assert_eq!(std::fs::read_to_string(&report).expect("read"), before);
+}

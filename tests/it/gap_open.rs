@@ -880,24 +880,112 @@ fn drake_sap_nominal_rms_z(design: &str, speed_only: bool) -> f64 {
 /// drive frequencies) falls from 65.3 to 16.0 RMS z at 3 % sd. Most of the rest is the
 /// walking direction at the design frequency (Drake walks these three backward, the
 /// project forward: set by the first cycles, reports/drake-crosscheck.md); compared as
-/// |v| the gap is 7.0 (with Coulomb friction 59.3). Bounds: a ratio below 0.3, below 10,
-/// and Coulomb's |v| gap above 5× the convex one. (The same figures come from `survey gap
-/// synth --expected` at the file's conditions, computed outside this code.)
+/// |v| the gap is 7.0 (with Coulomb friction 59.3), and |v| is how the diagnosis compares
+/// them, since `mugatu-ref-sap` walks either way (`criteria.walking_direction`). Bounds: a
+/// ratio below 0.3, below 10, and Coulomb's |v| gap above 5× the convex one. (The same
+/// figures come from `survey gap synth --expected` at the file's conditions, computed
+/// outside this code.)
 #[test]
 fn the_convex_cone_removes_most_of_the_drake_sap_engine_gap() {
     let coulomb = drake_sap_nominal_rms_z("mugatu-ref", false);
-    let convex = drake_sap_nominal_rms_z("mugatu-ref-sap", false);
-    assert!(
-        convex < 0.3 * coulomb,
-        "convex {convex} vs Coulomb {coulomb}"
-    );
     let convex_speed = drake_sap_nominal_rms_z("mugatu-ref-sap", true);
+    assert!(
+        convex_speed < 0.3 * coulomb,
+        "convex {convex_speed} vs Coulomb {coulomb}"
+    );
     let coulomb_speed = drake_sap_nominal_rms_z("mugatu-ref", true);
     assert!(convex_speed < 10.0, "convex, |v|: {convex_speed}");
     assert!(
         coulomb_speed > 5.0 * convex_speed,
         "Coulomb, |v|: {coulomb_speed}"
     );
+}
+
+/// A design that walks either way (`criteria.walking_direction = "either"`, mugatu-ref-sap)
+/// has its measured velocities compared as speeds: Drake-SAP walks three of the nine
+/// no-effect conditions backward (negative velocity in the committed file), and against
+/// mugatu-ref-sap each measured value becomes |v| while every other metric is kept; against
+/// mugatu-ref (forward) the signs stay. A sloped condition sets the direction, so there the
+/// sign is kept too. The speed comparison itself rests on the mirror symmetry of
+/// `a_fore_aft_symmetric_walker_driven_half_a_period_later_walks_the_mirror_gait`.
+#[test]
+fn a_walker_that_walks_either_way_is_compared_on_its_speed() {
+    let lib = EffectLibrary::bundled().expect("library");
+    let raw =
+        TrialSet::read(&repo().join("tests/golden/drake/gap/trials-none.csv")).expect("golden");
+    let velocity = |set: &TrialSet| -> Vec<f64> {
+        set.trials
+            .iter()
+            .map(|t| t.measured(Metric::VelocityMps).expect("velocity").value)
+            .collect()
+    };
+    let drake = velocity(&raw);
+    let backward = drake.iter().filter(|v| **v < 0.0).count();
+    assert!(
+        backward >= 1,
+        "the committed file walks backward somewhere: {drake:?}"
+    );
+    for (design, either) in [("mugatu-ref-sap", true), ("mugatu-ref", false)] {
+        let mut set = raw.clone();
+        for t in set.trials.iter_mut() {
+            t.design = design.to_string();
+        }
+        let conditions = resolve(&set).expect("resolve");
+        let (filled, _, _) =
+            robot_survey::gap::diagnose::measured(&set, &conditions, &lib, 0.03).expect("measured");
+        let expected: Vec<f64> = drake
+            .iter()
+            .map(|v| if either { v.abs() } else { *v })
+            .collect();
+        assert_eq!(velocity(&filled), expected, "{design}");
+        for (a, b) in filled.trials.iter().zip(&set.trials) {
+            for m in [Metric::RollPpDeg, Metric::PitchPpDeg, Metric::Cot] {
+                assert_eq!(a.measured(m), b.measured(m), "{design} {m:?}");
+            }
+        }
+    }
+    // On a slope the direction is the model's: the sign is kept.
+    let mut sloped = raw.clone();
+    for t in sloped.trials.iter_mut() {
+        t.design = "mugatu-ref-sap".into();
+        t.slope_deg = Some(1.0);
+    }
+    let conditions = resolve(&sloped).expect("resolve");
+    let (filled, _, _) =
+        robot_survey::gap::diagnose::measured(&sloped, &conditions, &lib, 0.03).expect("measured");
+    assert_eq!(velocity(&filled), drake);
+}
+
+/// `walking_direction = "either"` is refused, naming the file and the field, on a design
+/// that is not fore–aft symmetric as written.
+#[test]
+fn walking_either_way_needs_a_fore_aft_symmetric_design() {
+    let text =
+        std::fs::read_to_string(repo().join("dataset/walkers/reference/mugatu-ref-sap.toml"))
+            .expect("read");
+    assert!(Design::from_toml_str(&text, "m.toml").is_ok());
+    for (from, to, field) in [
+        (
+            "leg_com_forward_over_l = 0.0 ",
+            "leg_com_forward_over_l = 0.02 ",
+            "mass.leg_com_forward_over_l",
+        ),
+        (
+            "foot_center_forward_over_l = 0.0 ",
+            "foot_center_forward_over_l = 0.01 ",
+            "geometry.foot_center_forward_over_l",
+        ),
+        ("slope_deg = 0.0", "slope_deg = 0.5", "ground.slope_deg"),
+    ] {
+        assert!(text.contains(from), "{from}");
+        let e = Design::from_toml_str(&text.replacen(from, to, 1), "m.toml")
+            .expect_err(field)
+            .to_string();
+        assert!(
+            e.contains("m.toml") && e.contains(field) && e.contains("either"),
+            "{e}"
+        );
+    }
 }
 
 /// A knife-edge gait: the one-robot benchmark's COM height 0.495 L (the file's 0.45, +10 %;

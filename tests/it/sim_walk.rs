@@ -287,3 +287,43 @@ fn zippy_fixed_material_walks_when_scaled_up() {
         assert_walks_steadily(&walk_fixed_material("zippy", l));
     }
 }
+
+/// Mirror symmetry (x → −x) of a fore–aft symmetric design, derived by hand: the mirror
+/// image of a gait is a gait of the opposite drive (θ → −θ, the same sine half a period
+/// later) from the mirrored start (at rest rolled onto the right foot is its own mirror
+/// image), so it walks the other way at the same speed with the same attitude amplitudes
+/// and step frequency. Both directions therefore solve the same model, and which one a
+/// walker takes is set by where its start falls against the drive's phase: what
+/// `criteria.walking_direction = "either"` declares (the gap diagnosis then compares |v|).
+/// `mugatu-ref-sap` has its feet and leg COMs centred fore–aft.
+#[test]
+fn a_fore_aft_symmetric_walker_driven_half_a_period_later_walks_the_mirror_gait() {
+    let d = Design::builtin("mugatu-ref-sap").expect("bundled");
+    assert!(!d.criteria.walking_direction.is_forward());
+    let mirrored = d
+        .with_value("control.amplitude_deg", -25.0)
+        .expect("negative amplitude");
+    let opts = WalkOptions::default();
+    let a = simulate_walk(&d, &opts).expect("walk").report;
+    let b = simulate_walk(&mirrored, &opts).expect("walk").report;
+    assert!(a.velocity_mps.abs() > 0.1, "walks: {a:?}");
+    assert!(
+        a.velocity_mps * b.velocity_mps < 0.0,
+        "opposite directions: {} vs {}",
+        a.velocity_mps,
+        b.velocity_mps
+    );
+    let same = |what: &str, x: f64, y: f64| {
+        assert!(
+            (x - y).abs() <= 1e-3 * x.abs().max(y.abs()),
+            "{what}: {x} vs mirrored {y}"
+        );
+    };
+    same("speed", a.velocity_mps.abs(), b.velocity_mps.abs());
+    same("roll", a.roll_pp_deg, b.roll_pp_deg);
+    same("pitch", a.pitch_pp_deg, b.pitch_pp_deg);
+    same("yaw", a.yaw_pp_deg, b.yaw_pp_deg);
+    same("steps", a.step_frequency_hz, b.step_frequency_hz);
+    // Walking either way, the backward gait walks.
+    assert!(a.walks && b.walks, "{a:?} / {b:?}");
+}
