@@ -485,6 +485,12 @@ impl Design {
         }
     }
 
+    /// Whether this (scaled, set-up) design's direction is set by its start: it walks either
+    /// way and stands on the flat (a slope sets the direction).
+    pub fn walks_either_way(&self) -> bool {
+        !self.criteria.walking_direction.is_forward() && self.ground.slope_deg == 0.0
+    }
+
     /// A design that walks either way must be fore–aft symmetric as written (checked where
     /// a file is read, not on calibrated copies: a knob may move a COM or the slope off the
     /// symmetry, and is then judged on the speed it gives).

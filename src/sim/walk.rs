@@ -712,11 +712,12 @@ fn analyze(
         .iter()
         .map(|s| s.peak_abs_torque_nm)
         .fold(0.0, f64::max);
-    // A design that walks either way (fore–aft symmetric) walks backward as well as forward.
-    let speed = if d.criteria.walking_direction.is_forward() {
-        r.velocity_mps
-    } else {
+    // A design that walks either way (fore–aft symmetric, flat) walks backward as well as
+    // forward.
+    let speed = if d.walks_either_way() {
         r.velocity_mps.abs()
+    } else {
+        r.velocity_mps
     };
     r.walks = speed > d.criteria.walk_speed_threshold_mps(l);
     r
