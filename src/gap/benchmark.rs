@@ -210,7 +210,8 @@ pub struct CaseRow {
     /// Named knobs (`;`-joined): effects, and parameters as `design:path`.
     pub named_effects: String,
     pub named_params: String,
-    /// Named knobs with their 95 % intervals: `knob=lo..hi` joined by `;`.
+    /// Named knobs with their 95 % intervals: `knob=lo..hi` (`knob=±lo..hi`: a magnitude, its
+    /// sign not identified) joined by `;`.
     pub intervals: String,
     /// Groups of knobs the trials could not tell apart (`a|b` joined by `;`): not named.
     pub ambiguous: String,
@@ -992,7 +993,11 @@ fn run_case(
             .effects
             .iter()
             .chain(&d.answer.parameters)
-            .map(|n| format!("{}={}..{}", n.knob, n.interval[0], n.interval[1]))
+            .map(|n| {
+                // A magnitude (sign not identified) is marked `±`: it holds a truth of either sign.
+                let sign = if n.sign_identified { "" } else { "±" };
+                format!("{}={sign}{}..{}", n.knob, n.interval[0], n.interval[1])
+            })
             .collect::<Vec<_>>()
             .join(";"),
         leads: knobs(&d.answer.leads),
@@ -1176,10 +1181,19 @@ fn covered(row: &CaseRow, knob: &dyn Fn(&str) -> bool, v: f64) -> Option<bool> {
         if !knob(k) {
             return None;
         }
-        let (lo, hi) = r.split_once("..")?;
-        let (lo, hi): (f64, f64) = (lo.parse().ok()?, hi.parse().ok()?);
-        Some(v >= lo.min(hi) * (1.0 - 1e-9) - 1e-12 && v <= hi.max(lo) * (1.0 + 1e-9) + 1e-12)
+        interval_holds(r, v)
     })
+}
+
+/// Does the interval `lo..hi` (or the magnitudes `±lo..hi`) of a points file hold `v`?
+fn interval_holds(interval: &str, v: f64) -> Option<bool> {
+    let (r, v) = match interval.strip_prefix('±') {
+        Some(magnitude) => (magnitude, v.abs()),
+        None => (interval, v),
+    };
+    let (lo, hi) = r.split_once("..")?;
+    let (lo, hi): (f64, f64) = (lo.parse().ok()?, hi.parse().ok()?);
+    Some(v >= lo.min(hi) * (1.0 - 1e-9) - 1e-12 && v <= hi.max(lo) * (1.0 + 1e-9) + 1e-12)
 }
 
 /// A confusion matrix of `cases`: rows by `truth`, columns by what was `named`, both in
@@ -1667,4 +1681,20 @@ fn confusions(rows: &[CaseRow], noise_levels: &[f64]) -> Vec<Confusion> {
         ));
     }
     confusions
+}
+
+#[cfg(test)]
+mod tests {
+    use super::interval_holds;
+
+    /// A magnitude's interval holds a truth of either sign; a signed one only its own.
+    #[test]
+    fn a_magnitude_interval_holds_a_truth_of_either_sign() {
+        assert_eq!(interval_holds("1.4..1.6", 1.5), Some(true));
+        assert_eq!(interval_holds("1.4..1.6", -1.5), Some(false));
+        assert_eq!(interval_holds("±1.4..1.6", -1.5), Some(true));
+        assert_eq!(interval_holds("±1.4..1.6", 1.7), Some(false));
+        assert_eq!(interval_holds("-1.6..-1.4", -1.5), Some(true));
+        assert_eq!(interval_holds("x..1", 0.5), None);
+    }
 }

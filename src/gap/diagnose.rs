@@ -18,7 +18,7 @@ use super::curve::Curve;
 use super::error::GapError;
 use super::fit::{Fit, FitContext, ProfileInterval, dispersion, groupings, lr_p_value};
 use super::identify::{Identifiability, identifiability};
-use super::knob::{KnobKind, Knobs, ModelSetting};
+use super::knob::{Knob, KnobKind, Knobs, ModelSetting};
 use super::library::EffectLibrary;
 use super::locate::{MetricGap, Residual, metric_gaps, summarize};
 use super::problem::Observation;
@@ -125,6 +125,45 @@ pub struct Named {
     pub unit: String,
     /// Other knobs the trials cannot tell from this one.
     pub not_separable_from: Vec<String>,
+    /// False for a fore–aft mirror-odd parameter of a design that walks either way, fitted
+    /// only where the start sets the direction ([`sign_identified`]): `value` and `interval`
+    /// are then magnitudes, the sign open.
+    pub sign_identified: bool,
+}
+
+/// Whether trials at `conditions` identify the sign of `knob`. Not for a parameter that
+/// changes sign under the fore–aft mirror ([`crate::sim::MIRROR_ODD_PATHS`]) of a design that
+/// walks either way, when every condition where the parameter acts leaves the direction to
+/// the start ([`Condition::direction_free`]; a condition's own slope replaces the design's):
+/// the design with −v walks the mirror image of the gait the walker's other start (the
+/// drive half a period later) walks with v, its speed and attitude amplitudes the same, and
+/// which start the robot took is not a prediction of such a model. Measured on
+/// mugatu-ref-sap: on a 1.5° slope the two starts walk 0.034 and 0.075 m/s (both uphill),
+/// and the second is the exact mirror of the first start on −1.5°
+/// (`the_sign_of_a_mirror_odd_parameter_is_not_identified_where_the_start_sets_the_direction`).
+pub fn sign_identified(knob: &Knob, conditions: &[Condition]) -> bool {
+    if knob.kind != KnobKind::Parameter
+        || knob.log
+        || !crate::sim::MIRROR_ODD_PATHS.contains(&knob.name.as_str())
+    {
+        return true;
+    }
+    let mut acting = conditions
+        .iter()
+        .filter(|c| c.design.name == knob.design)
+        .filter(|c| !(knob.name == "ground.slope_deg" && c.slope_deg.is_some()))
+        .peekable();
+    acting.peek().is_none() || !acting.all(|c| c.direction_free())
+}
+
+/// A signed interval's magnitudes: |x| over [lo, hi].
+fn magnitude_interval(lo: f64, hi: f64) -> [f64; 2] {
+    let top = lo.abs().max(hi.abs());
+    if lo <= 0.0 && hi >= 0.0 {
+        [0.0, top]
+    } else {
+        [lo.abs().min(hi.abs()), top]
+    }
 }
 
 #[derive(Clone, Debug, Serialize)]
@@ -174,6 +213,9 @@ pub struct Calibrated {
     /// Interval width / range width: near 1, the trials do not constrain it.
     pub width_of_range: f64,
     pub why: String,
+    /// As [`Named::sign_identified`]: when false, `value`, `interval` and `move_in_sd` are
+    /// magnitudes.
+    pub sign_identified: bool,
 }
 
 /// A single knob's fit from the nominal (the "which knob alone" table).
@@ -904,15 +946,26 @@ fn calibrated(ctx: &FitContext<'_>, r: &Fit) -> Vec<Calibrated> {
                 open_above: true,
             });
             let nominal = knob.nominal.map(|x| knob.value(x)).unwrap_or(f64::NAN);
+            let signed = sign_identified(knob, ctx.conditions);
+            let (value, interval) = if signed {
+                (knob.value(x), [knob.value(iv.lo), knob.value(iv.hi)])
+            } else {
+                (
+                    knob.value(x).abs(),
+                    magnitude_interval(knob.value(iv.lo), knob.value(iv.hi)),
+                )
+            };
+            let moved = knob.prior.map(|(m, sd)| (knob.value(x) - m) / sd);
             Calibrated {
                 parameter: knob.label(),
                 nominal,
-                value: knob.value(x),
-                interval: [knob.value(iv.lo), knob.value(iv.hi)],
+                value,
+                interval,
                 range: [knob.value(knob.lo), knob.value(knob.hi)],
-                move_in_sd: knob.prior.map(|(m, sd)| (knob.value(x) - m) / sd),
+                move_in_sd: if signed { moved } else { moved.map(f64::abs) },
                 width_of_range: (iv.hi - iv.lo) / (knob.hi - knob.lo),
                 why: knob.why.clone(),
+                sign_identified: signed,
             }
         })
         .collect()
@@ -1019,18 +1072,28 @@ fn answer(
             KnobKind::Parameter => knob.nominal.map(|x| knob.si(x)),
             KnobKind::Effect => None,
         };
+        let signed = sign_identified(knob, ctx.conditions);
+        let (value, interval) = if signed {
+            (knob.si(x), [knob.si(lo), knob.si(hi)])
+        } else {
+            (
+                knob.si(x).abs(),
+                magnitude_interval(knob.si(lo), knob.si(hi)),
+            )
+        };
         let named = Named {
             knob: knob.label(),
             kind: knob.kind,
-            value: knob.si(x),
-            interval: [knob.si(lo), knob.si(hi)],
+            value,
+            interval,
             interval_open: open,
             nominal,
             change_pct: nominal
-                .filter(|v| *v != 0.0)
+                .filter(|v| *v != 0.0 && signed)
                 .map(|v| 100.0 * (knob.si(x) / v - 1.0)),
             unit: knob.unit.clone(),
             not_separable_from: step.not_separable_from.clone(),
+            sign_identified: signed,
         };
         if !step.not_separable_from.is_empty() {
             let mut group = vec![knob.label()];
@@ -1155,6 +1218,14 @@ fn named_text(n: &Named) -> String {
             n.not_separable_from.join(", ")
         )
     };
+    if !n.sign_identified {
+        return format!(
+            "{} = ±{v} {} {iv}{alt} (magnitude: its sign is not identified, since the design \
+             walks either way and the value's negative walks the mirror gait of the other start)",
+            n.knob, n.unit
+        )
+        .replace("  ", " ");
+    }
     format!("{} = {v} {}{change} {iv}{alt}", n.knob, n.unit).replace("  ", " ")
 }
 
@@ -1293,4 +1364,48 @@ fn residuals(
         });
     }
     Ok(out)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// |x| over a signed interval, derived by hand: an interval across 0 reaches 0; one on
+    /// either side keeps its ends' magnitudes, in order.
+    #[test]
+    fn a_signed_interval_becomes_the_magnitudes_it_holds() {
+        assert_eq!(magnitude_interval(-1.6, -1.4), [1.4, 1.6]);
+        assert_eq!(magnitude_interval(1.4, 1.6), [1.4, 1.6]);
+        assert_eq!(magnitude_interval(-0.2, 1.1), [0.0, 1.1]);
+        assert_eq!(magnitude_interval(-2.0, 0.5), [0.0, 2.0]);
+        assert_eq!(magnitude_interval(0.0, 0.3), [0.0, 0.3]);
+    }
+
+    /// A magnitude is stated as one, with its sign left open.
+    #[test]
+    fn a_magnitude_is_stated_with_its_sign_open() {
+        let n = Named {
+            knob: "d:ground.slope_deg".into(),
+            kind: KnobKind::Parameter,
+            value: 1.5,
+            interval: [1.4, 1.6],
+            interval_open: false,
+            nominal: Some(0.0),
+            change_pct: None,
+            unit: "deg".into(),
+            not_separable_from: Vec::new(),
+            sign_identified: false,
+        };
+        let t = named_text(&n);
+        assert!(
+            t.starts_with("d:ground.slope_deg = ±1.5 deg [1.4, 1.6]"),
+            "{t}"
+        );
+        assert!(t.contains("sign is not identified"), "{t}");
+        let signed = named_text(&Named {
+            sign_identified: true,
+            ..n
+        });
+        assert!(!signed.contains('±'), "{signed}");
+    }
 }

@@ -255,7 +255,12 @@ fn calibration_md(o: &mut String, d: &Diagnosis) {
             "| {} | {} | {} | {} – {} | {} – {} | {} | {:.2} | {} |",
             c.parameter,
             sig(c.nominal),
-            sig(c.value),
+            // A magnitude whose sign the trials cannot give (Calibrated::sign_identified).
+            if c.sign_identified {
+                sig(c.value)
+            } else {
+                format!("±{}", sig(c.value))
+            },
             sig(c.interval[0]),
             sig(c.interval[1]),
             sig(c.range[0]),

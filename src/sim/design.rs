@@ -192,6 +192,17 @@ pub struct CriteriaSpec {
     pub walking_direction: WalkingDirection,
 }
 
+/// The design fields that change sign under the fore–aft mirror (x → −x): a walker with
+/// the value v is the mirror image of the walker with −v. A design that walks either way has
+/// them at 0 as written; where its start sets the direction, a calibrated value and its
+/// negative walk mirror gaits of the walker's two starts, so the trials give the magnitude
+/// and not the sign (`gap diagnose` says so).
+pub const MIRROR_ODD_PATHS: [&str; 3] = [
+    "geometry.foot_center_forward_over_l",
+    "mass.leg_com_forward_over_l",
+    "ground.slope_deg",
+];
+
 /// Which way a design walks.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
@@ -491,7 +502,7 @@ impl Design {
         !self.criteria.walking_direction.is_forward() && self.ground.slope_deg == 0.0
     }
 
-    /// A design that walks either way must be fore–aft symmetric as written (checked where
+    /// A design that walks either way must be fore–aft symmetric as written ([`MIRROR_ODD_PATHS`] at 0) (checked where
     /// a file is read, not on calibrated copies: a knob may move a COM or the slope off the
     /// symmetry, and is then judged on the speed it gives).
     fn check_direction(&self, origin: &str) -> Result<(), SimError> {

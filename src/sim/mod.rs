@@ -33,7 +33,7 @@ pub use contact::{
     ContactParams, Cut, Patch, PatchWrench, patch, patch_forces, patch_into, patch_wrench,
 };
 pub use control::{Command, Controller};
-pub use design::{BUILTIN_DESIGNS, Design, FrictionCone, WalkingDirection};
+pub use design::{BUILTIN_DESIGNS, Design, FrictionCone, MIRROR_ODD_PATHS, WalkingDirection};
 pub use effects::{Effect, EffectContext, EffectSpec, GeneralizedForce};
 pub use error::SimError;
 pub use model::{Energy, FootSection, GRAVITY_MPS2, Hardstop, Leg, Model, Simulator, StepInfo};
