@@ -279,8 +279,9 @@ impl Model {
                 let mut force = Vector7::zeros();
                 Model::add_wrench(&mut force, k, kin, &r, &wr.force, &wr.moment);
                 let jn = jp.row(2);
+                let friction_damping = jc.transpose() * wr.friction_damping * jc;
                 let damping = jn.transpose() * jn * cn
-                    + jc.transpose() * wr.friction_damping * jc
+                    + friction_damping
                     + ja.transpose() * wr.rolling_damping * ja
                     + lift_k;
                 *convex_k = Some(ConvexContact {
@@ -288,7 +289,7 @@ impl Model {
                     normal_force_n: wr.force.z,
                     friction_force: jc.transpose()
                         * Vector3::new(wr.force.x, wr.force.y, wr.moment.z),
-                    friction_damping: jc.transpose() * wr.friction_damping * jc,
+                    friction_damping,
                     force,
                     damping,
                 });
