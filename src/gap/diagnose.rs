@@ -156,6 +156,16 @@ pub fn sign_identified(knob: &Knob, conditions: &[Condition]) -> bool {
     acting.peek().is_none() || !acting.all(|c| c.direction_free())
 }
 
+/// A fitted value and its interval as the answer states them: signed, or as magnitudes when
+/// [`sign_identified`] says the sign is open.
+fn as_stated(signed: bool, value: f64, [lo, hi]: [f64; 2]) -> (f64, [f64; 2]) {
+    if signed {
+        (value, [lo, hi])
+    } else {
+        (value.abs(), magnitude_interval(lo, hi))
+    }
+}
+
 /// A signed interval's magnitudes: |x| over [lo, hi].
 fn magnitude_interval(lo: f64, hi: f64) -> [f64; 2] {
     let top = lo.abs().max(hi.abs());
@@ -947,14 +957,11 @@ fn calibrated(ctx: &FitContext<'_>, r: &Fit) -> Vec<Calibrated> {
             });
             let nominal = knob.nominal.map(|x| knob.value(x)).unwrap_or(f64::NAN);
             let signed = sign_identified(knob, ctx.conditions);
-            let (value, interval) = if signed {
-                (knob.value(x), [knob.value(iv.lo), knob.value(iv.hi)])
-            } else {
-                (
-                    knob.value(x).abs(),
-                    magnitude_interval(knob.value(iv.lo), knob.value(iv.hi)),
-                )
-            };
+            let (value, interval) = as_stated(
+                signed,
+                knob.value(x),
+                [knob.value(iv.lo), knob.value(iv.hi)],
+            );
             let moved = knob.prior.map(|(m, sd)| (knob.value(x) - m) / sd);
             Calibrated {
                 parameter: knob.label(),
@@ -1073,14 +1080,7 @@ fn answer(
             KnobKind::Effect => None,
         };
         let signed = sign_identified(knob, ctx.conditions);
-        let (value, interval) = if signed {
-            (knob.si(x), [knob.si(lo), knob.si(hi)])
-        } else {
-            (
-                knob.si(x).abs(),
-                magnitude_interval(knob.si(lo), knob.si(hi)),
-            )
-        };
+        let (value, interval) = as_stated(signed, knob.si(x), [knob.si(lo), knob.si(hi)]);
         let named = Named {
             knob: knob.label(),
             kind: knob.kind,

@@ -512,24 +512,11 @@ impl Design {
         let ck = FieldCheck { origin };
         let why =
             "must be 0 for criteria.walking_direction = \"either\" (a fore–aft symmetric design)";
-        ck.check(
-            "geometry.foot_center_forward_over_l",
-            self.geometry.foot_center_forward_over_l,
-            self.geometry.foot_center_forward_over_l == 0.0,
-            why,
-        )?;
-        ck.check(
-            "mass.leg_com_forward_over_l",
-            self.mass.leg_com_forward_over_l,
-            self.mass.leg_com_forward_over_l == 0.0,
-            why,
-        )?;
-        ck.check(
-            "ground.slope_deg",
-            self.ground.slope_deg,
-            self.ground.slope_deg == 0.0,
-            why,
-        )
+        for path in MIRROR_ODD_PATHS {
+            let v = self.value_at(path)?;
+            ck.check(path, v, v == 0.0, why)?;
+        }
+        Ok(())
     }
 
     fn validate(&self, origin: &str) -> Result<(), SimError> {
