@@ -1,6 +1,8 @@
 //! Walks shared between fits, refits and diagnoses of trials over the same conditions (the
 //! benchmark runs thousands of diagnoses on one set): key = (condition, the setting's
-//! canonical key for that condition's design).
+//! canonical key for that condition's design). A condition is keyed by its content (its
+//! full `Debug` text, interned), not by its place in a list, so diagnoses of two trial sets
+//! over the same conditions share their walks whatever order or subset each lists.
 
 use std::collections::HashMap;
 use std::sync::Mutex;
@@ -12,12 +14,14 @@ use super::library::EffectLibrary;
 use super::simulate::{Condition, SimMetrics, simulate_jobs};
 use crate::progress::Observer;
 
-/// Walk metrics by (condition index, setting key).
+/// Walk metrics by (condition id, setting key).
 type WalkMap = HashMap<(usize, String), SimMetrics>;
 
 #[derive(Default)]
 pub struct SimCache {
     map: Mutex<WalkMap>,
+    /// Condition ids by the condition's `Debug` text (every field, f64s round-trip exact).
+    condition_ids: Mutex<HashMap<String, usize>>,
     walks: AtomicUsize,
 }
 
@@ -48,13 +52,14 @@ impl SimCache {
         settings: &[ModelSetting],
         progress: &dyn Observer,
     ) -> Result<Vec<Vec<SimMetrics>>, GapError> {
+        let ids = self.condition_ids(conditions)?;
         let keys: Vec<Vec<(usize, String)>> = settings
             .iter()
             .map(|s| {
                 conditions
                     .iter()
-                    .enumerate()
-                    .map(|(i, c)| (i, s.key_for(&c.design.name)))
+                    .zip(&ids)
+                    .map(|(c, id)| (*id, s.key_for(&c.design.name)))
                     .collect()
             })
             .collect();
@@ -64,9 +69,9 @@ impl SimCache {
             let map = self.lock()?;
             let mut queued = std::collections::HashSet::new();
             for (ks, s) in keys.iter().zip(settings) {
-                for k in ks {
+                for (i, k) in ks.iter().enumerate() {
                     if !map.contains_key(k) && queued.insert(k.clone()) {
-                        jobs.push((k.0, s.clone()));
+                        jobs.push((i, s.clone()));
                         job_keys.push(k.clone());
                     }
                 }
@@ -101,19 +106,22 @@ impl SimCache {
         setting: &ModelSetting,
         progress: &dyn Observer,
     ) -> Result<Vec<SimMetrics>, GapError> {
+        let ids = self.condition_ids(conditions)?;
         let keys: Vec<(usize, String)> = which
             .iter()
-            .map(|i| (*i, setting.key_for(&conditions[*i].design.name)))
+            .map(|i| (ids[*i], setting.key_for(&conditions[*i].design.name)))
             .collect();
-        let missing: Vec<(usize, String)> = {
+        let (missing_at, missing): (Vec<usize>, Vec<(usize, String)>) = {
             let map = self.lock()?;
-            keys.iter()
-                .filter(|k| !map.contains_key(*k))
-                .cloned()
-                .collect()
+            which
+                .iter()
+                .zip(&keys)
+                .filter(|(_, k)| !map.contains_key(*k))
+                .map(|(i, k)| (*i, k.clone()))
+                .unzip()
         };
         let jobs: Vec<(usize, ModelSetting)> =
-            missing.iter().map(|(i, _)| (*i, setting.clone())).collect();
+            missing_at.iter().map(|i| (*i, setting.clone())).collect();
         let done = simulate_jobs(&jobs, conditions, lib, progress)?;
         self.walks.fetch_add(jobs.len(), Ordering::Relaxed);
         let mut map = self.lock()?;
@@ -127,6 +135,20 @@ impl SimCache {
                     .ok_or_else(|| GapError::Invalid("cache miss after simulation".into()))
             })
             .collect()
+    }
+
+    /// The id of each condition (a new one for content not seen before).
+    fn condition_ids(&self, conditions: &[Condition]) -> Result<Vec<usize>, GapError> {
+        let mut ids = self.condition_ids.lock().map_err(|_| {
+            GapError::Invalid("a worker panicked while holding the walk cache".into())
+        })?;
+        Ok(conditions
+            .iter()
+            .map(|c| {
+                let next = ids.len();
+                *ids.entry(format!("{c:?}")).or_insert(next)
+            })
+            .collect())
     }
 
     fn lock(&self) -> Result<std::sync::MutexGuard<'_, WalkMap>, GapError> {

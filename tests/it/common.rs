@@ -84,3 +84,14 @@ pub fn reproducible_proptest(cases: u32) -> proptest::test_runner::Config {
     config.failure_persistence = None;
     config
 }
+
+/// One walk cache for every diagnosis in this test binary that uses the bundled effect
+/// library. The cache keys a walk by its condition's content and the model setting, and a
+/// walk is deterministic, so a test that finds its walks there gets the same bits it would
+/// walk itself: the committed benchmark trials share their conditions, and their diagnoses
+/// share the surrogate's walks instead of each walking them again.
+pub fn bundled_walks() -> &'static robot_survey::gap::cache::SimCache {
+    static WALKS: std::sync::OnceLock<robot_survey::gap::cache::SimCache> =
+        std::sync::OnceLock::new();
+    WALKS.get_or_init(Default::default)
+}

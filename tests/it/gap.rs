@@ -15,7 +15,7 @@ use robot_survey::gap::synth::{add_noise, default_conditions, truth_metrics};
 use robot_survey::gap::{EffectLibrary, TrialSet};
 use robot_survey::progress::Silent;
 
-use super::common::{repo, stderr, stdout, survey};
+use super::common::{bundled_walks, repo, stderr, stdout, survey};
 
 fn parse(text: &str) -> Result<TrialSet, String> {
     TrialSet::parse(text, "t.csv", std::path::Path::new(".")).map_err(|e| e.to_string())
@@ -215,7 +215,7 @@ struct Shared {
     lib: EffectLibrary,
     base: TrialSet,
     conditions: Vec<Condition>,
-    cache: SimCache,
+    cache: &'static SimCache,
 }
 
 /// The default Mugatu conditions, with one cache of walks for every case (the candidates'
@@ -234,7 +234,7 @@ fn shared() -> &'static Shared {
             lib,
             base,
             conditions,
-            cache: SimCache::default(),
+            cache: bundled_walks(),
         }
     })
 }
@@ -261,7 +261,7 @@ fn synth_and_diagnose(s: &Shared, effect: Option<(&str, f64)>, seed: u64) -> Dia
         identifiability: false,
         ..DiagnoseOptions::default()
     };
-    diagnose_conditions(&set, &s.conditions, &s.lib, &opts, &s.cache, &Silent)
+    diagnose_conditions(&set, &s.conditions, &s.lib, &opts, s.cache, &Silent)
         .expect("diagnosis")
         .0
 }
@@ -432,15 +432,8 @@ fn a_trajectory_file_is_measured_like_a_walk() {
         identifiability: false,
         ..DiagnoseOptions::default()
     };
-    let (d, _) = diagnose_conditions(
-        &set,
-        &conditions,
-        &lib,
-        &opts,
-        &SimCache::default(),
-        &Silent,
-    )
-    .expect("diagnosis");
+    let (d, _) = diagnose_conditions(&set, &conditions, &lib, &opts, bundled_walks(), &Silent)
+        .expect("diagnosis");
     assert_eq!(
         d.n_observations, 7,
         "every walk metric measured from the file"

@@ -19,7 +19,7 @@ use robot_survey::gap::trials::{Metric, TrialSet};
 use robot_survey::progress::Silent;
 use robot_survey::sim::Design;
 
-use super::common::{repo, stderr, stdout, survey};
+use super::common::{bundled_walks, repo, stderr, stdout, survey};
 
 const TEST_DESIGN: &str = "mugatu-two-uncertain";
 
@@ -27,7 +27,7 @@ struct Six {
     lib: EffectLibrary,
     base: TrialSet,
     conditions: Vec<Condition>,
-    cache: SimCache,
+    cache: &'static SimCache,
 }
 
 fn six() -> &'static Six {
@@ -40,7 +40,7 @@ fn six() -> &'static Six {
             lib: EffectLibrary::bundled().expect("library"),
             base,
             conditions,
-            cache: SimCache::default(),
+            cache: bundled_walks(),
         }
     })
 }
@@ -88,7 +88,7 @@ fn case_with(
         audit_undeclared: rules.audit_undeclared,
         ..DiagnoseOptions::default()
     };
-    diagnose_conditions(&set, &s.conditions, &s.lib, &opts, &s.cache, &Silent)
+    diagnose_conditions(&set, &s.conditions, &s.lib, &opts, s.cache, &Silent)
         .expect("diagnosis")
         .0
 }
@@ -398,6 +398,7 @@ fn assert_recovered(d: &Diagnosis, truths: &[(&str, f64)], tol: f64) {
 /// fits further (456 against 871 with all eight candidates), Coulomb friction passes, and
 /// backlash follows: both causes named, magnitudes within 10 %, nothing else.
 #[test]
+#[ignore = "heavy: 107 s in the suite on 2 threads; tools/heavy-tests.sh"]
 fn walked_levenberg_marquardt_lets_a_pair_beat_a_dozen_parameter_recalibration() {
     let select = SelectOptions {
         walked_lm: true,
@@ -412,7 +413,7 @@ fn walked_levenberg_marquardt_lets_a_pair_beat_a_dozen_parameter_recalibration()
         ],
         &select,
         false,
-        &SimCache::default(),
+        bundled_walks(),
     );
     assert_pair_named(
         &d,
@@ -484,11 +485,11 @@ fn plain_and_each(
     effects: &[&str],
     selects: &[SelectOptions],
 ) -> (Diagnosis, Vec<Diagnosis>) {
-    let cache = SimCache::default();
-    let plain = diagnose_committed(file, effects, &SelectOptions::plain(), false, &cache);
+    let cache = bundled_walks();
+    let plain = diagnose_committed(file, effects, &SelectOptions::plain(), false, cache);
     let with = selects
         .iter()
-        .map(|select| diagnose_committed(file, effects, select, false, &cache))
+        .map(|select| diagnose_committed(file, effects, select, false, cache))
         .collect();
     (plain, with)
 }
@@ -535,6 +536,7 @@ fn assert_pair_named(d: &Diagnosis, truths: [(&str, f64); 2]) {
 /// selection's answer on the same trials is checked too: without the option the pair is
 /// not named. The default selection (this option among the four rules) names both.
 #[test]
+#[ignore = "heavy: 389 s in the suite on 2 threads; tools/heavy-tests.sh"]
 fn a_deferred_recalibration_test_names_both_causes_of_a_pair() {
     let (plain, with) = plain_and_each(
         "motor-soft-3pct-bench.csv",
@@ -577,6 +579,7 @@ fn a_deferred_recalibration_test_names_both_causes_of_a_pair() {
 /// plain selection leaves damping unnamed on the same trials; the default selection (with
 /// `rivals_at_end` among its four rules) names both.
 #[test]
+#[ignore = "heavy: 236 s in the suite on 2 threads; tools/heavy-tests.sh"]
 fn look_alikes_compared_again_in_the_final_model_name_both_causes_of_a_pair() {
     let (plain, with) = plain_and_each(
         "backlash-damping-3pct-bench.csv",
@@ -626,7 +629,7 @@ fn intervals_of_two_named_knobs_that_trade_off_hold_both_truths() {
         &["rolling_resistance", "hip_viscous_damping"],
         &SelectOptions::default(),
         false,
-        &SimCache::default(),
+        bundled_walks(),
     );
     assert_eq!(d.answer.kind, AnswerKind::Both, "{}", d.answer.statement);
     assert_names(&d, &["mugatu:ground.slope_deg"], &["rolling_resistance"]);
@@ -644,6 +647,7 @@ fn intervals_of_two_named_knobs_that_trade_off_hold_both_truths() {
 /// identification distance (7.0): `look_alikes_at_end` finds it, and damping is not named
 /// (ambiguous with Coulomb friction) while the motor line stays named within 10 %.
 #[test]
+#[ignore = "heavy: 93 s in the suite on 2 threads; tools/heavy-tests.sh"]
 fn a_look_alike_found_again_in_the_final_model_unnames_a_stand_in() {
     let effects = [
         "hip_coulomb_friction",
@@ -686,6 +690,7 @@ fn a_look_alike_found_again_in_the_final_model_unnames_a_stand_in() {
 /// check must leave a true single cause named: damping alone (0.007 N·m·s/rad) and Coulomb
 /// friction alone (0.02 N·m), same conditions and noise, 3 % noise draws too.
 #[test]
+#[ignore = "heavy: 117 s in the suite on 2 threads; tools/heavy-tests.sh"]
 fn the_look_ahead_check_unnames_a_look_alike_that_won_the_first_step() {
     let candidates = [
         "hip_coulomb_friction",
@@ -766,6 +771,7 @@ fn the_look_ahead_check_unnames_a_look_alike_that_won_the_first_step() {
 /// named with its interval holding 0.02 N·m, no parameter named (expected trials and one
 /// 3 % draw).
 #[test]
+#[ignore = "heavy: 99 s in the suite on 2 threads; tools/heavy-tests.sh"]
 fn the_look_ahead_check_keeps_a_true_effect_beside_an_undeclared_error() {
     let look = SelectOptions {
         look_ahead: true,
@@ -805,6 +811,7 @@ fn the_look_ahead_check_keeps_a_true_effect_beside_an_undeclared_error() {
 /// `tests/golden/drake/gap/trials-none.csv`, made by the command in its README), plus 3 %
 /// noise: the engines' difference must not be blamed on a physical effect.
 #[test]
+#[ignore = "heavy: 2,716 s in the suite on 2 threads; tools/heavy-tests.sh"]
 fn a_drake_made_null_case_is_not_blamed_on_an_effect() {
     let lib = EffectLibrary::bundled().expect("library");
     let golden =
@@ -830,15 +837,8 @@ fn a_drake_made_null_case_is_not_blamed_on_an_effect() {
         identifiability: false,
         ..DiagnoseOptions::default()
     };
-    let (d, _) = diagnose_conditions(
-        &set,
-        &conditions,
-        &lib,
-        &opts,
-        &SimCache::default(),
-        &Silent,
-    )
-    .expect("diagnosis");
+    let (d, _) = diagnose_conditions(&set, &conditions, &lib, &opts, bundled_walks(), &Silent)
+        .expect("diagnosis");
     assert!(!d.within_noise, "the engines differ: a real gap");
     assert!(
         d.answer.effects.is_empty(),
@@ -1010,7 +1010,7 @@ fn a_knife_edge_gait_stops_the_search_at_the_simulators_resolution() {
     let d = diagnose_committed_with(
         "com-height-knife-edge-5pct-bench.csv",
         &opts,
-        &SimCache::default(),
+        bundled_walks(),
     );
     assert_eq!(
         d.answer.kind,
@@ -1605,11 +1605,11 @@ fn audit_tables_are_checked_and_name_the_field() {
 /// noise once the hip width stands in.
 #[test]
 fn the_audit_unnames_a_stand_in_for_an_undeclared_number() {
-    let cache = SimCache::default();
+    let cache = bundled_walks();
     let effects = ["rolling_resistance", "hip_viscous_damping"];
     let select = SelectOptions::default();
     let run = |audit: bool| {
-        diagnose_committed("roll-inertia-mu-3pct.csv", &effects, &select, audit, &cache)
+        diagnose_committed("roll-inertia-mu-3pct.csv", &effects, &select, audit, cache)
     };
     assert_hip_width_stands_in(&run(false), "without the audit");
     let d = run(true);
@@ -1654,9 +1654,10 @@ fn assert_hip_width_stands_in(d: &Diagnosis, when: &str) {
 /// three partial exchanges closest to the answer instead of the inertia edge: the hip width
 /// is still not named, but the truth's pair is not walked.)
 #[test]
+#[ignore = "heavy: 101 s in the suite on 2 threads; tools/heavy-tests.sh"]
 fn the_audits_declared_partner_unnames_a_stand_in_for_two_numbers() {
     // The benchmark's options: every effect of the library a candidate beside the calibration.
-    let cache = SimCache::default();
+    let cache = bundled_walks();
     let run = |partners: usize| {
         let opts = DiagnoseOptions {
             explanations: false,
@@ -1664,7 +1665,7 @@ fn the_audits_declared_partner_unnames_a_stand_in_for_two_numbers() {
             audit_partners: partners,
             ..DiagnoseOptions::default()
         };
-        diagnose_committed_with("roll-inertia-mu-3pct-bench.csv", &opts, &cache)
+        diagnose_committed_with("roll-inertia-mu-3pct-bench.csv", &opts, cache)
     };
     let hip_width = "mugatu:geometry.hip_half_width_over_l";
     assert_hip_width_stands_in(&run(0), "one number at a time");
@@ -1775,7 +1776,7 @@ fn default_diagnosis_of(file: &str) -> Diagnosis {
         &["rolling_resistance", "hip_viscous_damping"],
         &default.select,
         default.audit_undeclared,
-        &SimCache::default(),
+        bundled_walks(),
     )
 }
 
@@ -1903,6 +1904,7 @@ fn a_reference_carries_each_metric_onto_the_nominal() {
 /// whose mark depends on the friction it acts with (the carrying's premise fails), gets no
 /// name at all.
 #[test]
+#[ignore = "heavy: 190 s in the suite on 2 threads; tools/heavy-tests.sh"]
 fn a_reference_carries_a_change_where_the_model_misses_the_robot() {
     let s = six();
     let robot = [("contact.friction_mu", 0.5)];
@@ -1924,7 +1926,7 @@ fn a_reference_carries_a_change_where_the_model_misses_the_robot() {
             reference: reference.cloned(),
             ..DiagnoseOptions::default()
         };
-        diagnose_conditions(set, &s.conditions, &s.lib, &opts, &s.cache, &Silent)
+        diagnose_conditions(set, &s.conditions, &s.lib, &opts, s.cache, &Silent)
             .expect("diagnosis")
             .0
     };
@@ -1991,6 +1993,7 @@ fn a_reference_of_other_conditions_is_refused_by_line() {
 /// mark: the gap is real (the change is far beyond noise), and no effect may be named —
 /// rolling resistance and viscous damping each take part of it and lead the search.
 #[test]
+#[ignore = "heavy: 386 s in the suite on 2 threads; tools/heavy-tests.sh"]
 fn a_drake_change_our_model_does_not_share_gets_no_name() {
     let lib = EffectLibrary::bundled().expect("library");
     let dir = repo().join("tests/golden/drake/gap-lagged-heldout");
@@ -2013,15 +2016,8 @@ fn a_drake_change_our_model_does_not_share_gets_no_name() {
         reference: Some(reference),
         ..DiagnoseOptions::default()
     };
-    let (d, _) = diagnose_conditions(
-        &set,
-        &conditions,
-        &lib,
-        &opts,
-        &SimCache::default(),
-        &Silent,
-    )
-    .expect("diagnosis");
+    let (d, _) = diagnose_conditions(&set, &conditions, &lib, &opts, bundled_walks(), &Silent)
+        .expect("diagnosis");
     assert!(d.gap_before > 3.0, "{}", d.summary);
     assert_ne!(
         d.answer.kind,
@@ -2052,7 +2048,7 @@ fn a_simplex_on_walks_finds_the_narrow_valley_of_two_interacting_effects() {
         audit_undeclared: false,
         ..DiagnoseOptions::default()
     };
-    let d = diagnose_committed_with("backlash-motor-expected.csv", &opts, &SimCache::default());
+    let d = diagnose_committed_with("backlash-motor-expected.csv", &opts, bundled_walks());
     assert_pair_named_inside_intervals(
         &d,
         [("hip_backlash", 10.521), ("motor_torque_speed", 3.6834)],
@@ -2072,8 +2068,9 @@ fn a_simplex_on_walks_finds_the_narrow_valley_of_two_interacting_effects() {
 /// chain every rule accepts, and both are named with their truths inside their intervals
 /// (reports/gap-benchmark.md, fourteenth session).
 #[test]
+#[ignore = "heavy: 673 s in the suite on 2 threads; tools/heavy-tests.sh"]
 fn the_within_noise_subset_names_the_true_pair_behind_a_look_alike_taken_first() {
-    let cache = SimCache::default();
+    let cache = bundled_walks();
     let base = DiagnoseOptions {
         calibrate: true,
         explanations: false,
@@ -2089,13 +2086,13 @@ fn the_within_noise_subset_names_the_true_pair_behind_a_look_alike_taken_first()
         ..base.clone()
     };
     let file = "backlash-motor-3pct-bench.csv";
-    let d = diagnose_committed_with(file, &without, &cache);
+    let d = diagnose_committed_with(file, &without, cache);
     assert!(
         names(&d).1.len() < 2,
         "both named without the rule: {}",
         d.answer.statement
     );
-    let d = diagnose_committed_with(file, &base, &cache);
+    let d = diagnose_committed_with(file, &base, cache);
     assert_pair_named_inside_intervals(
         &d,
         [("hip_backlash", 10.521), ("motor_torque_speed", 3.6834)],
