@@ -139,9 +139,7 @@ impl SimCache {
 
     /// The id of each condition (a new one for content not seen before).
     fn condition_ids(&self, conditions: &[Condition]) -> Result<Vec<usize>, GapError> {
-        let mut ids = self.condition_ids.lock().map_err(|_| {
-            GapError::Invalid("a worker panicked while holding the walk cache".into())
-        })?;
+        let mut ids = locked(&self.condition_ids)?;
         Ok(conditions
             .iter()
             .map(|c| {
@@ -152,8 +150,12 @@ impl SimCache {
     }
 
     fn lock(&self) -> Result<std::sync::MutexGuard<'_, WalkMap>, GapError> {
-        self.map
-            .lock()
-            .map_err(|_| GapError::Invalid("a worker panicked while holding the walk cache".into()))
+        locked(&self.map)
     }
+}
+
+/// A lock of the cache's, or the error a panicked worker leaves.
+fn locked<T>(m: &Mutex<T>) -> Result<std::sync::MutexGuard<'_, T>, GapError> {
+    m.lock()
+        .map_err(|_| GapError::Invalid("a worker panicked while holding the walk cache".into()))
 }

@@ -2202,3 +2202,39 @@ fn the_sign_of_a_mirror_odd_parameter_is_not_identified_where_the_start_sets_the
         .expect("slope uncertain")];
     assert!(sign_identified(k, &forward.conditions));
 }
+
+/// One walk cache over two lists of the same conditions in other orders (the six reversed,
+/// then every second one): each condition gets its own walk, the one `Condition::simulate`
+/// walks directly, and the second and third lists walk nothing new. (A cache keyed by a
+/// condition's place in its list would hand the reversed list its mirror's walks.)
+#[test]
+fn a_shared_walk_cache_keys_a_condition_by_what_it_is_not_where_it_stands() {
+    let s = six();
+    let cache = SimCache::default();
+    let nominal = ModelSetting::nominal();
+    let values = |m: &robot_survey::gap::simulate::SimMetrics| m.values.map(f64::to_bits);
+    let first = cache
+        .get(&s.conditions, &s.lib, &nominal, &Silent)
+        .expect("walks");
+    let walked = cache.walks();
+    let reversed: Vec<Condition> = s.conditions.iter().rev().cloned().collect();
+    let again = cache
+        .get(&reversed, &s.lib, &nominal, &Silent)
+        .expect("walks");
+    let every_second = cache
+        .get_at(&reversed, &[1, 3, 5], &s.lib, &nominal, &Silent)
+        .expect("walks");
+    assert_eq!(cache.walks(), walked, "the reordered lists walked again");
+    for (i, c) in s.conditions.iter().enumerate() {
+        let direct = c.simulate(&s.lib, &nominal).expect("walk");
+        assert_eq!(values(&first[i]), values(&direct), "condition {i}");
+        assert_eq!(
+            values(&again[5 - i]),
+            values(&direct),
+            "reversed, condition {i}"
+        );
+    }
+    for (k, at) in [1, 3, 5].iter().enumerate() {
+        assert_eq!(values(&every_second[k]), values(&again[*at]), "get_at {at}");
+    }
+}
