@@ -71,16 +71,18 @@ same "$T/gz/gap-benchmark.json" gap-benchmark-zippy/gap-benchmark.json
 same "$T/gz/gap-benchmark.svg" gap-benchmark-zippy/gap-benchmark.svg
 # The Drake-Lagged folders diagnosed through their no-effect trials:
 # tests/golden/drake/gap-<name> gives reports/gap-benchmark-drake-<name>.
-drake_reference() {
+drake_reference() { # folder name, seeds (default 3)
   local r="gap-benchmark-drake-$1"
   "$S" gap benchmark --design mugatu --quick --noise 0.03,0.05 --null-cases 300 --one-robot-nulls 100 \
-    --drake "tests/golden/drake/gap-$1" --drake-seeds 3 --drake-reference \
+    --drake "tests/golden/drake/gap-$1" --drake-seeds "${2:-3}" --drake-reference \
     --merge "reports/$r.points.csv" --points "$T/$r.points.csv" --out "$T/$r" >/dev/null 2>&1
   prefix "$T/$r/gap-benchmark.md" "$r/gap-benchmark.md"
   same "$T/$r/gap-benchmark.json" "$r/gap-benchmark.json"
   same "$T/$r/gap-benchmark.svg" "$r/gap-benchmark.svg"
 }
 for name in lagged lagged-next lagged-heldout; do drake_reference "$name"; done
+# The same with the 1x trials' robot logs: the diagnosis followed by the logged cycles.
+drake_reference lagged-logs 5
 # Drake-SAP's trials against mugatu-ref-sap (the convex friction cone), plain and through the
 # no-effect trials: with the signed velocity (eighteenth session) and compared on speed
 # (criteria.walking_direction = "either"; nineteenth session, four of the nine files).

@@ -423,6 +423,18 @@ pub struct SeparateArgs {
     /// Figure of the measured cycles against the nominal and the best candidate (SVG or PNG).
     #[arg(long, value_name = "FILE")]
     pub plot: Option<PathBuf>,
+    /// Trials of the same robot at the same conditions without the change asked about
+    /// (before the damper, on the old floor, another engine without the effect): the
+    /// separation is then about what changed. Each summary and each logged cycle becomes the
+    /// nominal model's + (trial − reference), so a discrepancy the model has everywhere
+    /// cancels (as `gap diagnose --reference`). Every trial needs a reference trial of the
+    /// same condition; a log is compared only where its reference trial has one too. A trial
+    /// is used only where the nominal model walks the reference's gait (step frequency within
+    /// 5 %, speed, roll and pitch within 25 %, each plus 2 sd); where it walks none, the
+    /// answer is "not comparable". With logs, the carried summaries say which candidates are
+    /// plausible and the cycles tell those apart.
+    #[arg(long, value_name = "FILE")]
+    pub reference: Option<PathBuf>,
 }
 
 #[derive(Args, Debug)]
@@ -762,8 +774,12 @@ fn separate(a: &SeparateArgs) -> anyhow::Result<ExitCode> {
         default_relative_sd: a.default_sd,
         ..Default::default()
     };
+    let reference = a.reference.as_deref().map(TrialSet::read).transpose()?;
     let pb = spinner("walking the candidates");
-    let s = gap::separate::separate(&set, &lib, &opts, &pb)?;
+    let s = match &reference {
+        Some(r) => gap::separate::separate_relative(&set, r, &lib, &opts, &pb)?,
+        None => gap::separate::separate(&set, &lib, &opts, &pb)?,
+    };
     pb.clear();
     eprintln!("{} walks", s.walks);
     if let Some(p) = &a.plot {
@@ -910,27 +926,27 @@ fn diagnose(a: &DiagnoseArgs) -> anyhow::Result<ExitCode> {
         report::gap::residual_plot(&d, p)?;
         eprintln!("wrote {}", p.display());
     }
-    // Look-alike groups the summaries left, separated with the trials' logs (when they have
-    // any). Text only: the JSON stays the diagnosis (`survey gap separate --format json`
-    // gives a group's separation as JSON).
-    // Not with a reference: the carried numbers are no longer the logs' own.
+    // Look-alike groups the summaries left, and a single named knob, separated with the
+    // trials' logs (when they have any); with a reference, the cycles are carried through it
+    // as the summaries are. Text only: the JSON stays the diagnosis (`survey gap separate
+    // --format json` gives a group's separation as JSON).
     let follow = match a.format {
-        GapFormat::Text if opts.reference.is_none() => gap::separate::follow_up(
+        GapFormat::Text => Some(gap::separate::follow_up(
             &d,
             &set,
+            opts.reference.as_ref(),
             &lib,
             &gap::separate::SeparateOptions::default(),
             &Silent,
-        )?,
-        GapFormat::Text | GapFormat::Json => Vec::new(),
+        )?),
+        GapFormat::Json => None,
     };
     print(&match a.format {
         GapFormat::Json => report::json(&d)?,
         GapFormat::Text => {
             let mut text = report::gap::diagnosis_md(&d);
-            for s in &follow {
-                text.push_str("\n## The look-alike group, with the logged cycles\n\n");
-                text.push_str(&report::separation::separation_md(s));
+            if let Some(f) = &follow {
+                text.push_str(&report::separation::follow_up_md(f));
             }
             text
         }

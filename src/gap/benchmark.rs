@@ -15,7 +15,9 @@
 //! * `one-robot`: one size, conditions varied by drive frequency, amplitude, payload and
 //!   slope, as a user with one robot would measure.
 //! * `drake`: trials made by Drake on the reference design (`tests/golden/drake/gap/`),
-//!   with and without an effect added in Drake, plus measurement noise.
+//!   with and without an effect added in Drake, plus measurement noise. Where the trials
+//!   name robot logs (`tests/golden/drake/gap-lagged-logs/`), the logs get sensor noise too
+//!   and the diagnosis is followed by the logged cycles ([`super::separate::follow_up_with`]).
 //!
 //! Every case is a row of a points file (resumable, shardable, mergeable like the sweeps);
 //! the scores are computed from the rows ([`summarize`]).
@@ -34,9 +36,13 @@ use super::identify::Identifiability;
 use super::knob::ModelSetting;
 use super::library::{EffectLibrary, EffectSetting};
 use super::select::SelectOptions;
+use super::separate::{CycleCache, FollowPurpose, Reference, SeparateOptions, follow_up_with};
 use super::simulate::{Condition, SimMetrics, resolve};
-use super::synth::{add_noise, default_conditions, expected_trials, truth_metrics};
+use super::synth::{
+    SensorNoise, add_noise, add_sensor_noise, default_conditions, expected_trials, truth_metrics,
+};
 use super::trials::{Measurement, Metric, Trial, TrialSet};
+use super::waveform::{CycleSignature, LogSample};
 use crate::checkpoint::{Shard, SweepPoint, append_to, finish_points, open_log, spec_line};
 use crate::progress::{Observer, Silent};
 use crate::regression::dist::{binomial_interval, binomial_upper_bound};
@@ -220,6 +226,18 @@ pub struct CaseRow {
     pub gap_before: f64,
     pub gap_after: Option<f64>,
     pub walks: usize,
+    /// Trials whose logged cycles were compared after the diagnosis (Drake trials with
+    /// robot logs); 0: none (the next two fields are then empty).
+    #[serde(default)]
+    pub logged_trials: usize,
+    /// What the cycles said, per separation: `ambiguous:a|b→verdict` or
+    /// `confirm:a|b|c→verdict`, `;`-joined.
+    #[serde(default)]
+    pub cycles: String,
+    /// The names that stand with the cycles (`;`-joined; effects, and parameters as
+    /// `design:path`).
+    #[serde(default)]
+    pub cycles_named: String,
 }
 
 impl SweepPoint for CaseRow {
@@ -386,6 +404,8 @@ struct Suite {
     base: TrialSet,
     conditions: Vec<Condition>,
     cache: SimCache,
+    /// Walks with their cycles, shared by the follow-ups of cases with logs.
+    cycles: CycleCache,
 }
 
 impl Suite {
@@ -396,6 +416,7 @@ impl Suite {
             base,
             conditions,
             cache: SimCache::default(),
+            cycles: CycleCache::default(),
         })
     }
 }
@@ -411,7 +432,15 @@ pub struct Plan {
     model_spread_seeds: u64,
     drake_reference: bool,
     suites: Vec<Suite>,
-    drake: BTreeMap<String, (TrialSet, Vec<SimMetrics>)>,
+    drake: BTreeMap<String, DrakeFile>,
+}
+
+/// One Drake trials file: its trials, their metrics as the truth, and the robot logs its
+/// rows name (read once; each case adds its own sensor noise).
+struct DrakeFile {
+    set: TrialSet,
+    truth: Vec<SimMetrics>,
+    logs: Vec<Option<Vec<LogSample>>>,
 }
 
 fn truth_setting(
@@ -476,10 +505,12 @@ pub fn plan(
     let mut drake = BTreeMap::new();
     if let Some(dir) = &opts.drake_dir {
         drake = drake_cases(opts, dir, &mut cases)?;
-        if let Some((set, _)) = drake.values().next() {
-            let mut base = set.clone();
+        if let Some(first) = drake.values().next() {
+            let mut base = first.set.clone();
             for t in base.trials.iter_mut() {
                 t.measured = [None; 8];
+                // Each case's logs are its file's, in memory (`DrakeFile::logs`).
+                t.trajectory = None;
             }
             suites.push(Suite::new("drake", base)?);
         }
@@ -805,8 +836,8 @@ fn drake_cases(
     opts: &BenchmarkOptions,
     dir: &Path,
     cases: &mut Vec<CaseSpec>,
-) -> Result<BTreeMap<String, (TrialSet, Vec<SimMetrics>)>, GapError> {
-    let mut drake: BTreeMap<String, (TrialSet, Vec<SimMetrics>)> = BTreeMap::new();
+) -> Result<BTreeMap<String, DrakeFile>, GapError> {
+    let mut drake: BTreeMap<String, DrakeFile> = BTreeMap::new();
     let mut files: Vec<PathBuf> = std::fs::read_dir(dir)
         .map_err(|source| GapError::Read {
             path: dir.to_path_buf(),
@@ -847,8 +878,8 @@ fn drake_cases(
             .and_then(|rest| rest.rsplit_once('-'))
             .and_then(|(e, v)| Some((e.to_string(), v.parse::<f64>().ok()?)));
         // One suite serves every Drake file: its conditions must be the first file's.
-        if let Some((first, _)) = drake.values().next()
-            && !same_conditions(first, &set)?
+        if let Some(first) = drake.values().next()
+            && !same_conditions(&first.set, &set)?
         {
             return Err(GapError::File {
                 path: f.display().to_string(),
@@ -859,6 +890,16 @@ fn drake_cases(
             });
         }
         let truth: Vec<SimMetrics> = set.trials.iter().map(SimMetrics::measured_by).collect();
+        let logs = set
+            .trials
+            .iter()
+            .map(|t| {
+                t.trajectory
+                    .as_ref()
+                    .map(|rel| super::waveform::read_log_csv(&set.base_dir.join(rel)))
+                    .transpose()
+            })
+            .collect::<Result<Vec<_>, _>>()?;
         for seed in 0..opts.drake_seeds {
             let key = format!("drake/{name}/n{}/s{seed}", opts.pair_noise);
             cases.push(CaseSpec {
@@ -875,7 +916,7 @@ fn drake_cases(
                 },
             });
         }
-        drake.insert(name, (set, truth));
+        drake.insert(name, DrakeFile { set, truth, logs });
     }
     Ok(drake)
 }
@@ -923,7 +964,7 @@ fn run_case(
         Truth::Drake { file, .. } => plan
             .drake
             .get(file)
-            .map(|(_, t)| t.clone())
+            .map(|f| f.truth.clone())
             .ok_or_else(|| GapError::Invalid(format!("no Drake trials {file}")))?,
     };
     let trials = if case.kind == EXPECTED_PAIR {
@@ -945,10 +986,11 @@ fn run_case(
     // The reference: Drake's no-effect trials with noise of their own (another seed).
     let reference = match &case.truth {
         Truth::Drake { .. } if plan.drake_reference => {
-            let (_, truth) = plan
+            let truth = &plan
                 .drake
                 .get(DRAKE_NONE)
-                .ok_or_else(|| GapError::Invalid(format!("no Drake trials {DRAKE_NONE}")))?;
+                .ok_or_else(|| GapError::Invalid(format!("no Drake trials {DRAKE_NONE}")))?
+                .truth;
             let key = format!("{}/reference", case.key);
             Some(TrialSet {
                 origin: key.clone(),
@@ -965,7 +1007,7 @@ fn run_case(
         _ => None,
     };
     let opts = DiagnoseOptions {
-        reference,
+        reference: reference.clone(),
         effects: Vec::new(),
         calibrate: case.calibrate,
         explanations: false,
@@ -978,6 +1020,12 @@ fn run_case(
     };
     let walks0 = suite.cache.walks();
     let (d, _) = diagnose_conditions(&set, &suite.conditions, lib, &opts, &suite.cache, &Silent)?;
+    let cycles = match &case.truth {
+        Truth::Drake { file, .. } => {
+            drake_cycles(case, plan, suite, file, &set, reference.as_ref(), &d, lib)?
+        }
+        Truth::Sim { .. } => None,
+    };
     let knobs = |v: &[super::diagnose::Named]| {
         v.iter()
             .map(|n| n.knob.clone())
@@ -1010,9 +1058,153 @@ fn run_case(
             .join(";"),
         gap_before: d.gap_before,
         gap_after: d.chain.last().map(|s| s.gap_after),
-        walks: suite.cache.walks() - walks0,
+        walks: suite.cache.walks() - walks0 + cycles.as_ref().map_or(0, |c| c.walks),
+        logged_trials: cycles.as_ref().map_or(0, |c| c.logged_trials),
+        cycles: cycles.as_ref().map_or(String::new(), |c| c.said.clone()),
+        cycles_named: cycles.map_or(String::new(), |c| c.named),
         ..CaseRow::unanswered(case, design)
     })
+}
+
+/// What the logged cycles said about one Drake case.
+struct DrakeCycles {
+    logged_trials: usize,
+    said: String,
+    named: String,
+    walks: usize,
+}
+
+/// The cycles of one trial set's logs, each with sensor noise of its own (seeded by the
+/// case's key, the set's role and the trial): `None` where a trial has no log or its log
+/// gives no steady cycles.
+fn noisy_signatures(
+    logs: &[Option<Vec<LogSample>>],
+    conditions: &[Condition],
+    key: &str,
+    settle_cycles: usize,
+) -> Result<Vec<Option<CycleSignature>>, GapError> {
+    logs.iter()
+        .zip(conditions)
+        .enumerate()
+        .map(|(i, (log, c))| {
+            let Some(log) = log else { return Ok(None) };
+            let noisy = add_sensor_noise(
+                log,
+                SensorNoise::default(),
+                seed_of(&format!("{key}/log/{i}")),
+            );
+            let f = c.drive_frequency_hz()?;
+            Ok(super::waveform::signature(&noisy, f, settle_cycles).ok())
+        })
+        .collect()
+}
+
+/// A Drake case whose file names robot logs: after the diagnosis, its look-alike groups and
+/// its single named knob separated with the logged cycles (sensor noise added as `survey
+/// gap synth --logs` adds it), through the no-effect trials' logs when the run is
+/// `--drake-reference`. `None` when the file has no logs.
+#[allow(clippy::too_many_arguments)]
+fn drake_cycles(
+    case: &CaseSpec,
+    plan: &Plan,
+    suite: &Suite,
+    file: &str,
+    set: &TrialSet,
+    reference: Option<&TrialSet>,
+    d: &super::diagnose::Diagnosis,
+    lib: &EffectLibrary,
+) -> Result<Option<DrakeCycles>, GapError> {
+    let logs = &plan
+        .drake
+        .get(file)
+        .ok_or_else(|| GapError::Invalid(format!("no Drake trials {file}")))?
+        .logs;
+    if logs.iter().all(Option::is_none) {
+        return Ok(None);
+    }
+    let opts = SeparateOptions::default();
+    let sigs = noisy_signatures(logs, &suite.conditions, &case.key, opts.settle_cycles)?;
+    let reference_sigs = match reference {
+        Some(_) => {
+            let none = plan
+                .drake
+                .get(DRAKE_NONE)
+                .ok_or_else(|| GapError::Invalid(format!("no Drake trials {DRAKE_NONE}")))?;
+            Some(noisy_signatures(
+                &none.logs,
+                &suite.conditions,
+                &format!("{}/reference", case.key),
+                opts.settle_cycles,
+            )?)
+        }
+        None => None,
+    };
+    let through = match (reference, &reference_sigs) {
+        (Some(r), Some(rs)) => Some(Reference {
+            set: r,
+            conditions: &suite.conditions,
+            sigs: rs,
+        }),
+        _ => None,
+    };
+    let f = follow_up_with(
+        d,
+        set,
+        &suite.conditions,
+        &sigs,
+        through.as_ref(),
+        lib,
+        &opts,
+        &suite.cycles,
+        &Silent,
+    )?;
+    if std::env::var("GAP_DEBUG").is_ok() {
+        for g in &f.groups {
+            for r in &g.separation.rankings {
+                eprintln!(
+                    "{} {:?} {:?} phi {:.2} n {}",
+                    case.key, r.evidence, r.verdict, r.overdispersion, r.observations
+                );
+                for c in &r.fits {
+                    eprintln!(
+                        "   {} {:.4} s {:.1} w {:.1} d {:.2}",
+                        c.knob, c.value, c.chi2_summaries, c.chi2_waveforms, c.delta
+                    );
+                }
+            }
+            for n in &g.separation.notes {
+                eprintln!("   note: {n}");
+            }
+        }
+    }
+    let said = f
+        .groups
+        .iter()
+        .map(|g| {
+            let (purpose, group) = match &g.purpose {
+                FollowPurpose::Ambiguous => ("ambiguous", &g.separation),
+                FollowPurpose::Confirm { .. } => ("confirm", &g.separation),
+                FollowPurpose::Explore => ("explore", &g.separation),
+            };
+            let candidates: Vec<String> = group
+                .rankings
+                .first()
+                .map(|r| r.fits.iter().map(|c| c.knob.clone()).collect())
+                .unwrap_or_default();
+            format!(
+                "{purpose}:{}→{}",
+                candidates.join("|"),
+                super::separate::verdict_words(&g.verdict)
+            )
+        })
+        .collect::<Vec<_>>()
+        .join(";");
+    Ok(Some(DrakeCycles {
+        logged_trials: sigs.iter().filter(|s| s.is_some()).count(),
+        said,
+        named: f.named.join(";"),
+        walks: f.groups.iter().map(|g| g.separation.walks).sum(),
+    }))
 }
 
 impl CaseRow {
@@ -1053,6 +1245,9 @@ impl CaseRow {
             gap_before: f64::NAN,
             gap_after: None,
             walks: 0,
+            logged_trials: 0,
+            cycles: String::new(),
+            cycles_named: String::new(),
         }
     }
 }
@@ -1568,6 +1763,70 @@ fn drake_scores(rows: &[CaseRow], aliases: &BTreeMap<String, String>, scores: &m
         with.len(),
         "low",
     ));
+    // With the logged cycles: the same questions of the names that stand after them.
+    let logged: Vec<CaseRow> = drake
+        .iter()
+        .filter(|r| r.logged_trials > 0)
+        .map(|r| with_cycles(r))
+        .collect();
+    if logged.is_empty() {
+        return;
+    }
+    let nulls: Vec<&CaseRow> = logged
+        .iter()
+        .filter(|r| r.truth_effects.is_empty())
+        .collect();
+    scores.push(score(
+        "Drake with logged cycles, no effect added: anything named (the answer with the cycles)",
+        nulls.iter().filter(|r| any_named(r)).count(),
+        nulls.len(),
+        "0 %",
+    ));
+    let with: Vec<&CaseRow> = logged
+        .iter()
+        .filter(|r| !r.truth_effects.is_empty())
+        .collect();
+    scores.push(score(
+        "Drake with logged cycles, effect added: that effect named (the answer with the cycles)",
+        with.iter()
+            .filter(|r| names_every_truth_effect(r, aliases))
+            .count(),
+        with.len(),
+        "high",
+    ));
+    scores.push(score(
+        "Drake with logged cycles, effect added: another knob named (the answer with the cycles)",
+        with.iter().filter(|r| names_other_knob(r, aliases)).count(),
+        with.len(),
+        "low",
+    ));
+}
+
+/// A case's row with the names that stand after the logged cycles in place of the
+/// answer's: effects, and parameters (`design:path`).
+fn with_cycles(r: &CaseRow) -> CaseRow {
+    let names = split(&r.cycles_named);
+    let (params, effects): (Vec<String>, Vec<String>) =
+        names.into_iter().partition(|n| n.contains(':'));
+    CaseRow {
+        named_effects: effects.join(";"),
+        named_params: params.join(";"),
+        ..r.clone()
+    }
+}
+
+/// A knob named that is neither a truth's effect nor the parameter a truth's effect is an
+/// alias of.
+fn names_other_knob(r: &CaseRow, aliases: &BTreeMap<String, String>) -> bool {
+    let truth = parse_pairs(&r.truth_effects);
+    let truth_params: Vec<String> = truth
+        .iter()
+        .filter_map(|(e, _)| aliases.get(e).map(|p| format!(":{p}")))
+        .collect();
+    names_other_effect(r)
+        || split(&r.named_params)
+            .iter()
+            .any(|n| !truth_params.iter().any(|p| n.ends_with(p.as_str())))
 }
 
 /// Interval coverage over every case whose true knob was named with an interval.

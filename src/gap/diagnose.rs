@@ -283,7 +283,7 @@ pub struct Timing {
 /// the code that measures the simulator's walks (`sim::report_from_trajectory`); at a
 /// condition whose direction the start sets ([`Condition::direction_free`]) the measured
 /// velocity becomes a speed |v|, as the simulated one is.
-fn fill_from_trajectories(
+pub(super) fn fill_from_trajectories(
     set: &TrialSet,
     conditions: &[Condition],
     lib: &EffectLibrary,

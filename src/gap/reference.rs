@@ -24,7 +24,8 @@ use super::error::GapError;
 use super::fit::{Fit, FitContext};
 use super::select::{Step, within_noise};
 use super::simulate::{Condition, SimMetrics};
-use super::trials::{Measurement, Metric, TrialSet};
+use super::trials::{Measurement, Metric, Trial, TrialSet};
+use super::waveform::{CycleSignature, FIGURE_BINS, SignalCycle, evaluate};
 
 /// The carried trials and what the carrying did, in words.
 #[derive(Clone, Debug)]
@@ -176,6 +177,134 @@ pub fn carry(
     })
 }
 
+/// How far the nominal model may miss a reference trial's gait and still be taken to walk
+/// it: the step frequency within [`LIKE_STEP_TOLERANCE`], the speed (as the diagnosis
+/// compares it) and the roll and pitch amplitudes within this fraction of the reference's.
+/// Measured (`tests/golden/drake/gap-lagged-logs/README.md`): Drake-Lagged's Mugatu and the
+/// project's on the same model, "the same gait within 5–15 %", miss each other by at most
+/// 15 % on these four at every condition; Drake-SAP's and the project's Coulomb Mugatu,
+/// whose gaits differ (one walks where the other scuffs), by 36–600 %.
+pub const LIKE_GAIT_TOLERANCE: f64 = 0.25;
+/// The step frequency's tolerance: the same gait steps at the same rate (a period-1 gait is
+/// locked to the drive; Drake-Lagged and the project agree to 0.1 %).
+pub const LIKE_STEP_TOLERANCE: f64 = 0.05;
+
+/// Does the nominal model walk the reference trial's gait? `Ok` when it does, else why not
+/// (the first metric out of tolerance). A change carried through a reference is the
+/// change's mark on the robot put on the model; it stands for the change's mark on the model
+/// only where the two walk the same gait (the carrying is a first-order, additive
+/// correction). Each metric may miss by its tolerance of the reference's value plus twice the
+/// reference's sd (stated, or `default_relative_sd` of the value): a noisy reference is not
+/// another gait (measured: at 3 % noise the step frequency of Drake-Lagged's no-effect trials
+/// drew 6 % off in one draw of five). A metric the reference does not state is not checked;
+/// a nominal walk that fell walks no gait.
+pub fn like_gait(
+    reference: &Trial,
+    nominal: &SimMetrics,
+    default_relative_sd: f64,
+) -> Result<(), String> {
+    if nominal.fell {
+        return Err("the nominal model falls there".into());
+    }
+    for (m, tol) in [
+        (Metric::StepFrequencyHz, LIKE_STEP_TOLERANCE),
+        (Metric::VelocityMps, LIKE_GAIT_TOLERANCE),
+        (Metric::RollPpDeg, LIKE_GAIT_TOLERANCE),
+        (Metric::PitchPpDeg, LIKE_GAIT_TOLERANCE),
+    ] {
+        let Some(r) = reference.measured(m) else {
+            continue;
+        };
+        let n = nominal.get(m);
+        let (sd, _) = r.sd_or(default_relative_sd);
+        let allowed = tol * r.value.abs() + 2.0 * sd;
+        let miss = (n - r.value).abs();
+        // A NaN miss (a metric the model lacks) is out of tolerance too.
+        if miss.is_nan() || miss > allowed {
+            return Err(format!(
+                "{} {:.3} (model) vs {:.3} (reference): {:.0} % apart, beyond {:.0} % + 2 sd",
+                m.column(),
+                n,
+                r.value,
+                100.0 * miss / r.value.abs(),
+                100.0 * tol
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// A logged cycle carried onto the nominal model as the summaries are ([`carry`]): each
+/// Fourier coefficient becomes `nominal + (trial − reference)`, its sd the three means' own
+/// (cycle-to-cycle spread / √cycles of the trial, the reference and the nominal walk) and the
+/// carrying's, |change| · ρ with ρ = |rms_reference − rms_nominal| / rms_reference per signal:
+/// had the discrepancy been a gain (the robot's cycle a scaled copy of the model's), the change
+/// would have been scaled by rms_nominal / rms_reference. A discrepancy of *shape* (a phase,
+/// other harmonics) cancels in the difference and is not charged. Measured on Drake-Lagged's
+/// Mugatu at 1.55 Hz (`tests/golden/drake/gap-lagged-logs/README.md`): the two engines' hip
+/// torque cycles differ by 33 % of the signal's RMS, their amplitudes by 1.6 %, and the change
+/// an added hip damper makes correlates 0.999 between them.
+///
+/// The result has `cycles = 1` and `spread` the sd of each carried coefficient, so that
+/// [`super::waveform::chi2`] counts it as it counts a measured mean. Signals that one of the
+/// three lacks are dropped; `None` when none is left.
+pub fn carry_cycles(
+    trial: &CycleSignature,
+    reference: &CycleSignature,
+    nominal: &CycleSignature,
+) -> Option<CycleSignature> {
+    let mut signals = Vec::new();
+    for t in &trial.signals {
+        let (Some(r), Some(n)) = (reference.signal(t.signal), nominal.signal(t.signal)) else {
+            continue;
+        };
+        let k = t.coefficients.len();
+        if r.coefficients.len() != k || n.coefficients.len() != k {
+            continue;
+        }
+        let rho = if r.rms > 0.0 {
+            ((r.rms - n.rms) / r.rms).abs().min(1.0)
+        } else {
+            1.0
+        };
+        let mean_var =
+            |c: &SignalCycle, cycles: usize, i: usize| c.spread[i].powi(2) / cycles.max(1) as f64;
+        let mut coefficients = Vec::with_capacity(k);
+        let mut spread = Vec::with_capacity(k);
+        for i in 0..k {
+            let change = t.coefficients[i] - r.coefficients[i];
+            let value = n.coefficients[i] + change;
+            if !value.is_finite() {
+                coefficients.push(f64::NAN);
+                spread.push(f64::NAN);
+                continue;
+            }
+            let var = mean_var(t, trial.cycles, i)
+                + mean_var(r, reference.cycles, i)
+                + mean_var(n, nominal.cycles, i)
+                + (change * rho).powi(2);
+            coefficients.push(value);
+            spread.push(var.sqrt());
+        }
+        let rms = (coefficients[1..].iter().map(|a| a * a).sum::<f64>() / 2.0).sqrt();
+        let cycle = (0..FIGURE_BINS)
+            .map(|b| evaluate(&coefficients, (b as f64 + 0.5) / FIGURE_BINS as f64))
+            .collect();
+        signals.push(SignalCycle {
+            signal: t.signal,
+            coefficients,
+            spread,
+            rms,
+            cycle,
+        });
+    }
+    (!signals.is_empty()).then_some(CycleSignature {
+        drive_frequency_hz: trial.drive_frequency_hz,
+        cycles: 1,
+        signals,
+    })
+}
+
 /// Single-knob rivals walked by [`rivals_within_noise`]: the best by the surrogate.
 const RIVAL_WALKS: usize = 3;
 
@@ -250,4 +379,167 @@ pub fn rivals_within_noise(
         if rivals.len() == 1 { "it" } else { "them" }
     ));
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::gap::waveform::Signal;
+
+    /// A signal whose coefficients are `head` then zeros, with the same spread everywhere
+    /// and the RMS of its cycle about its mean (Parseval: √(Σ_{k≥1} c²/2)).
+    fn signal(signal: Signal, head: &[f64], spread: f64) -> SignalCycle {
+        let mut coefficients = vec![0.0; 25];
+        coefficients[..head.len()].copy_from_slice(head);
+        let rms = (coefficients[1..].iter().map(|a| a * a).sum::<f64>() / 2.0).sqrt();
+        SignalCycle {
+            signal,
+            coefficients,
+            spread: vec![spread; 25],
+            rms,
+            cycle: Vec::new(),
+        }
+    }
+
+    fn sig(cycles: usize, signals: Vec<SignalCycle>) -> CycleSignature {
+        CycleSignature {
+            drive_frequency_hz: 1.5,
+            cycles,
+            signals,
+        }
+    }
+
+    /// Hand-derived: trial [1, 2], reference [1, 1], nominal [0.5, 1.2] (mean, first cosine).
+    /// The change is [0, 1], so the carried cycle is [0.5, 2.2]. ρ = |rms_R − rms_N| / rms_R =
+    /// |1/√2 − 1.2/√2| / (1/√2) = 0.2. Variance of the first cosine: 0.3²/4 (trial) + 0.4²/4
+    /// (reference) + 0 (nominal) + (1 · 0.2)² = 0.0225 + 0.04 + 0.04 = 0.1025; of the mean,
+    /// whose change is 0: 0.0625. Yaw's mean (NaN: the heading) stays NaN, and a signal the
+    /// reference lacks is dropped.
+    #[test]
+    fn carried_cycle_is_nominal_plus_change_with_hand_derived_sds() {
+        let trial = sig(
+            4,
+            vec![
+                signal(Signal::HipTorque, &[1.0, 2.0], 0.3),
+                signal(Signal::Yaw, &[f64::NAN, 3.0], 0.3),
+                signal(Signal::Roll, &[0.0, 5.0], 0.3),
+            ],
+        );
+        let reference = sig(
+            4,
+            vec![
+                signal(Signal::HipTorque, &[1.0, 1.0], 0.4),
+                signal(Signal::Yaw, &[f64::NAN, 3.0], 0.4),
+            ],
+        );
+        let nominal = sig(
+            16,
+            vec![
+                signal(Signal::HipTorque, &[0.5, 1.2], 0.0),
+                signal(Signal::Yaw, &[f64::NAN, 2.0], 0.0),
+                signal(Signal::Roll, &[0.0, 4.0], 0.0),
+            ],
+        );
+        let c = carry_cycles(&trial, &reference, &nominal).expect("carried");
+        assert_eq!(c.cycles, 1);
+        assert_eq!(c.signals.len(), 2, "roll has no reference cycle");
+        let t = c.signal(Signal::HipTorque).expect("torque");
+        assert!((t.coefficients[0] - 0.5).abs() < 1e-12);
+        assert!((t.coefficients[1] - 2.2).abs() < 1e-12);
+        assert!((t.spread[0] - 0.0625f64.sqrt()).abs() < 1e-12);
+        assert!((t.spread[1] - 0.1025f64.sqrt()).abs() < 1e-12);
+        assert!((t.rms - 2.2 / 2f64.sqrt()).abs() < 1e-12);
+        // The figure's cycle is the carried coefficients evaluated: 0.5 + 2.2·cos 2πφ.
+        let phi = 0.5 / FIGURE_BINS as f64;
+        assert!((t.cycle[0] - (0.5 + 2.2 * (std::f64::consts::TAU * phi).cos())).abs() < 1e-12);
+        let y = c.signal(Signal::Yaw).expect("yaw");
+        assert!(y.coefficients[0].is_nan() && y.spread[0].is_nan());
+        // Yaw: reference and nominal amplitudes 3 and 2 → ρ = 1/3; the change is 0.
+        assert!((y.coefficients[1] - 2.0).abs() < 1e-12);
+    }
+
+    /// Drake-Lagged's Mugatu at 1.55 Hz against the project's (`tests/golden/drake/
+    /// gap-lagged/README.md`, "Do the engines agree here?"): the same gait, within 11 % on
+    /// roll, 8 % on pitch, 0.4 % on speed. Drake-SAP's at its design frequency against the
+    /// project's Coulomb Mugatu (`tests/golden/drake/gap/trials-none.csv`, L1x-f1x, and the
+    /// project's 0.013 m/s scuff, roll 64°): not the same gait, and the first metric out
+    /// (the speed) says why. A fallen
+    /// nominal walks no gait; a metric the reference does not state is not checked.
+    #[test]
+    fn like_gait_holds_for_drake_lagged_and_not_for_a_gait_the_model_does_not_walk() {
+        let mut reference = Trial::condition("mugatu-ref", 0.153);
+        let set = |t: &mut Trial, m: Metric, v: f64| {
+            t.measured[m.index()] = Some(Measurement { value: v, sd: None });
+        };
+        set(&mut reference, Metric::VelocityMps, 0.2023);
+        set(&mut reference, Metric::StepFrequencyHz, 3.1);
+        set(&mut reference, Metric::RollPpDeg, 13.1);
+        set(&mut reference, Metric::PitchPpDeg, 14.5);
+        let mut values = [f64::NAN; 8];
+        values[Metric::VelocityMps.index()] = 0.2014;
+        values[Metric::StepFrequencyHz.index()] = 3.1;
+        values[Metric::RollPpDeg.index()] = 14.6;
+        values[Metric::PitchPpDeg.index()] = 15.7;
+        let lagged = SimMetrics {
+            values,
+            fell: false,
+        };
+        assert_eq!(like_gait(&reference, &lagged, 0.0), Ok(()));
+        // Roll 30 % above the reference's: another gait.
+        let mut rocking = lagged;
+        rocking.values[Metric::RollPpDeg.index()] = 13.1 * 1.3;
+        let why = like_gait(&reference, &rocking, 0.0).expect_err("unlike");
+        assert!(
+            why.starts_with("roll_pp_deg") && why.contains("30 %"),
+            "{why}"
+        );
+        // With the reference's noise counted (3 % sd: 2 sd = 6 % more), roll 30 % above is
+        // within 25 % + 2 sd; 40 % is not.
+        assert_eq!(like_gait(&reference, &rocking, 0.03), Ok(()));
+        let mut rocking_more = lagged;
+        rocking_more.values[Metric::RollPpDeg.index()] = 13.1 * 1.4;
+        assert!(like_gait(&reference, &rocking_more, 0.03).is_err());
+        // A step every other drive cycle (half the step frequency): another gait, however
+        // close the rest.
+        let mut skipping = lagged;
+        skipping.values[Metric::StepFrequencyHz.index()] = 1.55;
+        assert!(like_gait(&reference, &skipping, 0.0).is_err());
+        // Drake-SAP at the design frequency (1x): walks backward at 0.167 m/s with roll 13.7°;
+        // the project's Coulomb Mugatu scuffs (0.0016 m/s here as a stand-in, roll 64°).
+        let mut sap = Trial::condition("mugatu-ref", 0.153);
+        set(&mut sap, Metric::VelocityMps, -0.167);
+        set(&mut sap, Metric::RollPpDeg, 13.65);
+        let mut scuff = [f64::NAN; 8];
+        scuff[Metric::VelocityMps.index()] = 0.0016;
+        scuff[Metric::RollPpDeg.index()] = 64.2;
+        let why = like_gait(
+            &sap,
+            &SimMetrics {
+                values: scuff,
+                fell: false,
+            },
+            0.0,
+        )
+        .expect_err("unlike");
+        assert!(why.starts_with("velocity_mps"), "{why}");
+        let fell = SimMetrics {
+            fell: true,
+            ..lagged
+        };
+        assert!(like_gait(&reference, &fell, 0.0).is_err());
+        // Nothing stated, nothing checked.
+        let bare = Trial::condition("mugatu-ref", 0.153);
+        assert_eq!(like_gait(&bare, &rocking, 0.0), Ok(()));
+    }
+
+    /// The null: trials that are their reference carry exactly onto the nominal walk.
+    #[test]
+    fn a_trial_equal_to_its_reference_carries_onto_the_nominal() {
+        let t = sig(5, vec![signal(Signal::HipTorque, &[0.2, 1.0, -0.5], 0.1)]);
+        let n = sig(16, vec![signal(Signal::HipTorque, &[0.1, 0.7, 0.3], 0.0)]);
+        let c = carry_cycles(&t, &t, &n).expect("carried");
+        let s = c.signal(Signal::HipTorque).expect("torque");
+        assert_eq!(&s.coefficients[..3], &[0.1, 0.7, 0.3]);
+        assert!(carry_cycles(&t, &sig(5, Vec::new()), &n).is_none());
+    }
 }

@@ -17,7 +17,7 @@ use std::sync::{Arc, Mutex};
 use rayon::prelude::*;
 use serde::Serialize;
 
-use super::diagnose::{designs_of, measured};
+use super::diagnose::{AnswerKind, designs_of, measured};
 use super::error::GapError;
 use super::knob::{KnobKind, Knobs};
 use super::library::EffectLibrary;
@@ -43,6 +43,10 @@ pub struct SeparateOptions {
     pub alpha: f64,
     /// Relative sd assumed for a measurement that states none.
     pub default_relative_sd: f64,
+    /// Set by [`separate_through`]: the evidence is carried through a reference, so with
+    /// cycles the summaries decide which candidates are plausible and the cycles rank them
+    /// (`Fitted::ranking`).
+    pub through_reference: bool,
 }
 
 impl Default for SeparateOptions {
@@ -55,6 +59,7 @@ impl Default for SeparateOptions {
             settle_cycles: 6,
             alpha: 0.01,
             default_relative_sd: 0.10,
+            through_reference: false,
         }
     }
 }
@@ -110,6 +115,9 @@ pub enum Verdict {
     CannotTell { group: Vec<String> },
     /// No candidate fits within noise; where the best one's rest lies.
     NoneFits { rest_in: String },
+    /// Through a reference: the nominal model walks none of the reference trials' gaits, so
+    /// no change can be carried onto it ([`super::reference::like_gait`]).
+    NotComparable { why: String },
 }
 
 #[derive(Clone, Debug, Serialize)]
@@ -214,6 +222,220 @@ pub fn separate(
         set,
         &conditions,
         &sigs,
+        lib,
+        opts,
+        &CycleCache::default(),
+        progress,
+    )
+}
+
+/// Trials of the same robot without the change asked about, and their measured cycles: the
+/// reference a separation is made through ([`separate_through`]).
+pub struct Reference<'a> {
+    pub set: &'a TrialSet,
+    pub conditions: &'a [Condition],
+    pub sigs: &'a [Option<CycleSignature>],
+}
+
+/// [`separate_with`] on what changed between `reference` and `set`: the summaries carried
+/// onto the nominal model as `gap diagnose --reference` carries them
+/// ([`super::reference::carry`]), and each logged cycle likewise
+/// ([`super::reference::carry_cycles`]), so that a discrepancy the model has at every
+/// condition (another engine's contact, an unmodelled structure) cancels in both kinds of
+/// evidence. A trial's cycles are carried only where the trial, its reference trial and the
+/// nominal walk all have them.
+#[allow(clippy::too_many_arguments)]
+pub fn separate_through(
+    set: &TrialSet,
+    conditions: &[Condition],
+    sigs: &[Option<CycleSignature>],
+    reference: &Reference<'_>,
+    lib: &EffectLibrary,
+    opts: &SeparateOptions,
+    cache: &CycleCache,
+    progress: &dyn Observer,
+) -> Result<Separation, GapError> {
+    check(opts)?;
+    if sigs.len() != set.trials.len() || reference.sigs.len() != reference.set.trials.len() {
+        return Err(GapError::Invalid(format!(
+            "{}: {} trials but {} cycle signatures; reference {}: {} trials but {}",
+            set.origin,
+            set.trials.len(),
+            sigs.len(),
+            reference.set.origin,
+            reference.set.trials.len(),
+            reference.sigs.len()
+        )));
+    }
+    let walker = Walker {
+        conditions,
+        lib,
+        settle_cycles: opts.settle_cycles,
+        cache,
+        progress,
+        walks: std::sync::atomic::AtomicUsize::new(0),
+    };
+    let nominal = walker.run((String::new(), 0), &super::knob::ModelSetting::nominal())?;
+    let filled = super::diagnose::fill_from_trajectories(set, conditions, lib)?;
+    let filled_reference =
+        super::diagnose::fill_from_trajectories(reference.set, reference.conditions, lib)?;
+    let nominal_metrics: Vec<SimMetrics> = nominal.iter().map(|s| s.metrics).collect();
+    let carried = super::reference::carry(
+        &filled,
+        conditions,
+        &filled_reference,
+        reference.conditions,
+        &nominal_metrics,
+        opts.default_relative_sd,
+    )?;
+    // Only where the model walks the reference's gait is the change carried (both kinds of
+    // evidence); elsewhere the trial is left out, with why.
+    let mut carried_set = carried.set;
+    let mut unlike: Vec<String> = Vec::new();
+    let like: Vec<bool> = conditions
+        .iter()
+        .zip(nominal.iter())
+        .zip(&set.trials)
+        .map(|((c, nom), t)| {
+            let r = reference
+                .conditions
+                .iter()
+                .position(|rc| super::reference::same_condition(c, rc))
+                .map(|j| &filled_reference.trials[j]);
+            match r.map(|r| super::reference::like_gait(r, &nom.metrics, opts.default_relative_sd))
+            {
+                Some(Ok(())) | None => true,
+                Some(Err(why)) => {
+                    unlike.push(format!("{}: {why}", t.name()));
+                    false
+                }
+            }
+        })
+        .collect();
+    for (t, &ok) in carried_set.trials.iter_mut().zip(&like) {
+        if !ok {
+            t.measured = [None; 8];
+        }
+    }
+    if !like.iter().any(|&l| l) {
+        let why = format!(
+            "the nominal model walks none of the reference trials' gaits ({}): a change \
+             carried onto it would not be its mark on the model",
+            unlike.join("; ")
+        );
+        let mut notes = carried.notes;
+        notes.push(why.clone());
+        return Ok(Separation {
+            trials: set.trials.len(),
+            trials_with_logs: sigs.iter().filter(|s| s.is_some()).count(),
+            relative_floor: opts.relative_floor,
+            alpha: opts.alpha,
+            rankings: vec![Ranking {
+                evidence: Evidence::Summaries,
+                fits: Vec::new(),
+                nominal_chi2: f64::NAN,
+                observations: 0,
+                overdispersion: 1.0,
+                best_p_value: f64::NAN,
+                verdict: Verdict::NotComparable { why },
+            }],
+            cycles: Vec::new(),
+            notes,
+            walks: walker.walks.into_inner(),
+        });
+    }
+    let mut uncarried = 0usize;
+    let carried_sigs: Vec<Option<CycleSignature>> = sigs
+        .iter()
+        .zip(conditions)
+        .zip(nominal.iter())
+        .zip(&like)
+        .map(|(((t, c), nom), &ok)| {
+            let t = t.as_ref().filter(|_| ok)?;
+            let r = reference
+                .conditions
+                .iter()
+                .position(|rc| super::reference::same_condition(c, rc))
+                .and_then(|j| reference.sigs[j].as_ref());
+            let out = match (r, &nom.cycles) {
+                (Some(r), Some(n)) => super::reference::carry_cycles(t, r, n),
+                _ => None,
+            };
+            if out.is_none() {
+                uncarried += 1;
+            }
+            out
+        })
+        .collect();
+    let through = SeparateOptions {
+        through_reference: true,
+        ..opts.clone()
+    };
+    let mut sep = separate_with(
+        &carried_set,
+        conditions,
+        &carried_sigs,
+        lib,
+        &through,
+        cache,
+        progress,
+    )?;
+    let mut notes = carried.notes;
+    if !unlike.is_empty() {
+        notes.push(format!(
+            "{} trial(s) left out: the nominal model does not walk the reference's gait there \
+             (within {:.0} % on speed, roll and pitch, {:.0} % on step frequency), so a change \
+             carried there is not its mark on the model: {}",
+            unlike.len(),
+            100.0 * super::reference::LIKE_GAIT_TOLERANCE,
+            100.0 * super::reference::LIKE_STEP_TOLERANCE,
+            unlike.join("; ")
+        ));
+    }
+    if sigs.iter().any(Option::is_some) {
+        notes.push(format!(
+            "relative to the reference, each logged cycle is the nominal walk's + (trial − \
+             reference), coefficient by coefficient, its sd the three means' and the change × \
+             the model's relative miss of the reference's amplitude combined{}",
+            if uncarried > 0 {
+                format!(
+                    "; {uncarried} trial log(s) not carried: the reference trial of the same \
+                     condition has no log, or the nominal walk fell"
+                )
+            } else {
+                String::new()
+            }
+        ));
+    }
+    notes.append(&mut sep.notes);
+    sep.notes = notes;
+    sep.walks += walker.walks.into_inner();
+    Ok(sep)
+}
+
+/// [`separate`] through `reference` ([`separate_through`]), reading the logs both sets'
+/// rows name.
+pub fn separate_relative(
+    set: &TrialSet,
+    reference: &TrialSet,
+    lib: &EffectLibrary,
+    opts: &SeparateOptions,
+    progress: &dyn Observer,
+) -> Result<Separation, GapError> {
+    check(opts)?;
+    let conditions = resolve(set)?;
+    let sigs = measured_signatures(set, &conditions, opts.settle_cycles)?;
+    let reference_conditions = resolve(reference)?;
+    let reference_sigs = measured_signatures(reference, &reference_conditions, opts.settle_cycles)?;
+    separate_through(
+        set,
+        &conditions,
+        &sigs,
+        &Reference {
+            set: reference,
+            conditions: &reference_conditions,
+            sigs: &reference_sigs,
+        },
         lib,
         opts,
         &CycleCache::default(),
@@ -534,7 +756,31 @@ impl Fitted<'_> {
                 }
             })
             .collect();
-        list.sort_by(|a, b| a.chi2.total_cmp(&b.chi2));
+        let dof = |n: usize| (n.max(2) - 1) as f64;
+        let nb = if mi == 1 { 2.0 } else { 1.0 };
+        // Through a reference, with cycles: which look-alike carried summaries favour is
+        // the engines' business (the carried numbers hold an error no sd counts; measured on
+        // Drake-Lagged's hip Coulomb friction 0.05 N·m, noise-free: the summaries favour
+        // viscous damping by Δχ² 18.6), while a hip loss changes the robot's cycle as it
+        // changes the model's (r ≥ 0.994). So the summaries say which candidates are
+        // plausible (within noise there), the cycles rank those, and a plausible rival is
+        // told apart only by the cycles.
+        let cycles_decide = mi == 1 && opts.through_reference && self.n_wave > 0;
+        let plausible = |f: &CandidateFit| {
+            (nb * chi2_upper_p(f.chi2_summaries, dof(obs.len())).unwrap_or(0.0)).min(1.0)
+                >= opts.alpha
+        };
+        if cycles_decide {
+            list.sort_by(|a, b| {
+                plausible(b).cmp(&plausible(a)).then(if plausible(a) {
+                    a.chi2_waveforms.total_cmp(&b.chi2_waveforms)
+                } else {
+                    a.chi2.total_cmp(&b.chi2)
+                })
+            });
+        } else {
+            list.sort_by(|a, b| a.chi2.total_cmp(&b.chi2));
+        }
         let best = list[0].chi2;
         // Each block of evidence (summaries; cycles) is tested on its own: pooled, a few
         // hundred well-fitting cycle coefficients would dilute a summary gap into "no gap"
@@ -548,18 +794,28 @@ impl Fitted<'_> {
         } else {
             vec![(obs.len(), list[0].chi2_summaries, nom_s)]
         };
-        let dof = |n: usize| (n.max(2) - 1) as f64;
         let phi = blocks
             .iter()
             .map(|(n, c, _)| c / dof(*n))
             .fold(1.0f64, f64::max);
         let per_test = opts.alpha / (list.len() - 1) as f64;
+        let (best_plausible, best_w) = (plausible(&list[0]), list[0].chi2_waveforms);
         for f in list.iter_mut().skip(1) {
+            if cycles_decide && best_plausible {
+                if plausible(f) {
+                    f.delta = (f.chi2_waveforms - best_w) / phi;
+                    f.separated = chi2_upper_p(f.delta, 1.0).unwrap_or(1.0) < per_test;
+                } else {
+                    // Implausible on the summaries: told apart there.
+                    f.delta = (f.chi2 - best) / phi;
+                    f.separated = true;
+                }
+                continue;
+            }
             f.delta = (f.chi2 - best) / phi;
             f.separated = chi2_upper_p(f.delta, 1.0).unwrap_or(1.0) < per_test;
         }
         let nominal_chi2 = cost(nom_s, nom_w);
-        let nb = blocks.len() as f64;
         let block_p = |c: f64, n: usize| (nb * chi2_upper_p(c, dof(n)).unwrap_or(0.0)).min(1.0);
         let best_p = blocks
             .iter()
@@ -570,8 +826,13 @@ impl Fitted<'_> {
         // misses a gap a single knob explains. But a nominal that fails the goodness-of-fit
         // test has a gap whether or not a candidate beats it: then the answer is about the
         // candidates' fit ("none fits"), never "no gap".
-        let lr_gap =
-            chi2_upper_p(((nominal_chi2 - best) / phi).max(0.0), 1.0).unwrap_or(0.0) < opts.alpha;
+        let lr_gap = chi2_upper_p(
+            ((nominal_chi2 - list.iter().map(|f| f.chi2).fold(f64::INFINITY, f64::min)) / phi)
+                .max(0.0),
+            1.0,
+        )
+        .unwrap_or(0.0)
+            < opts.alpha;
         let nominal_fits = blocks
             .iter()
             .map(|(n, _, c)| block_p(*c, *n))
@@ -702,36 +963,259 @@ fn rest_in(
         .unwrap_or_default()
 }
 
-/// A diagnosis's look-alike groups, separated with the trials' logs: for each group the
-/// diagnosis could not resolve (`answer.ambiguous`), the separation of its knobs (each
-/// alone, the rest at the file's values). Empty when no trial names a robot log or nothing
-/// is ambiguous: then there is nothing the cycles could add.
-pub fn follow_up(
+/// Why a group of knobs was separated with the cycles after a diagnosis.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+#[serde(tag = "kind", rename_all = "snake_case")]
+pub enum FollowPurpose {
+    /// A look-alike group the summaries could not resolve (`answer.ambiguous`), with the
+    /// best single knobs outside it: the cycles may name one of them.
+    Ambiguous,
+    /// The answer's one named knob against its closest single-knob rivals (by held-out
+    /// gap): the name stands only if the cycles name it too.
+    Confirm { knob: String },
+    /// The summaries left the gap beyond noise with nothing named (partly explained or
+    /// unexplained): the answer's leads and the best single knobs, in case the cycles tell.
+    Explore,
+}
+
+/// One separation made after a diagnosis.
+#[derive(Clone, Debug, Serialize)]
+pub struct FollowGroup {
+    pub purpose: FollowPurpose,
+    pub separation: Separation,
+    /// The verdict of the richest evidence (summaries + waveforms when any log was compared).
+    pub verdict: Verdict,
+}
+
+/// What the logged cycles add to a diagnosis: the separations and the names that stand.
+#[derive(Clone, Debug, Default, Serialize)]
+pub struct FollowUp {
+    pub groups: Vec<FollowGroup>,
+    /// The knobs named with the cycles: the answer's names that the cycles confirmed (or
+    /// that were not checked: an answer of two knobs or more), plus the knob the cycles name
+    /// in a look-alike group.
+    pub named: Vec<String>,
+    /// Names the cycles took away, with why.
+    pub withdrawn: Vec<String>,
+}
+
+/// Single-knob rivals a named knob is confirmed against.
+const CONFIRM_RIVALS: usize = 2;
+/// Candidates separated when the summaries name nothing and leave the gap beyond noise: the
+/// answer's leads, then the best single knobs by held-out gap.
+const EXPLORE_CANDIDATES: usize = 3;
+
+/// The verdict of a separation's richest evidence.
+fn final_verdict(s: &Separation) -> Verdict {
+    s.rankings
+        .last()
+        .map(|r| r.verdict.clone())
+        .unwrap_or(Verdict::NoGap)
+}
+
+/// The logged cycles after a diagnosis (`answer`, `single` of `d`), on resolved conditions
+/// and measured cycles (`sigs`, as [`measured_signatures`]; the benchmark's are in memory):
+///
+/// * each look-alike group the summaries left (`answer.ambiguous`) is separated, with its
+///   [`CONFIRM_RIVALS`] best single-knob rivals outside it; a knob the cycles name there is
+///   named;
+/// * an answer that names nothing and leaves the gap beyond noise (partly explained or
+///   unexplained) has its leads and the best single knobs (up to [`EXPLORE_CANDIDATES`])
+///   separated; a knob the cycles name there — fitting within noise in the summaries and in
+///   the cycles, every rival worse beyond the test — is named;
+/// * an answer that names exactly one knob has it separated from its [`CONFIRM_RIVALS`]
+///   closest single-knob rivals (by held-out gap); the name stands only if the cycles name
+///   the same knob — a rival named instead, "cannot tell", "none fits" or "no gap" withdraw
+///   it. This rule only takes names away: a summary-only name that the cycles contradict is
+///   the confident wrong answer a look-alike gives (measured on Drake-Lagged's hip Coulomb
+///   friction 0.05 N·m, named hip viscous damping on the summaries:
+///   `tests/golden/drake/gap-lagged-logs/README.md`). An answer of two knobs or more is not
+///   checked (a single knob alone would not fit a compound cause).
+///
+/// Nothing is done (an empty follow-up, the answer's names standing) when no trial has a
+/// log. With `reference`, each separation is made through it ([`separate_through`]).
+#[allow(clippy::too_many_arguments)]
+pub fn follow_up_with(
     d: &super::diagnose::Diagnosis,
     set: &TrialSet,
+    conditions: &[Condition],
+    sigs: &[Option<CycleSignature>],
+    reference: Option<&Reference<'_>>,
     lib: &EffectLibrary,
     opts: &SeparateOptions,
+    cache: &CycleCache,
     progress: &dyn Observer,
-) -> Result<Vec<Separation>, GapError> {
-    if d.answer.ambiguous.is_empty() || set.trials.iter().all(|t| t.trajectory.is_none()) {
-        return Ok(Vec::new());
-    }
-    let conditions = resolve(set)?;
-    let sigs = measured_signatures(set, &conditions, opts.settle_cycles)?;
+) -> Result<FollowUp, GapError> {
+    let answer_names: Vec<String> = d
+        .answer
+        .effects
+        .iter()
+        .chain(&d.answer.parameters)
+        .map(|n| n.knob.clone())
+        .collect();
+    let mut out = FollowUp {
+        named: answer_names.clone(),
+        ..FollowUp::default()
+    };
     if sigs.iter().all(Option::is_none) {
-        return Ok(Vec::new());
+        return Ok(out);
     }
-    let cache = CycleCache::default();
-    d.answer
+    // A group is the summaries' look-alikes; the truth may be a knob the diagnosis did not
+    // put in it (measured on Drake-Lagged: hip Coulomb friction 0.015 N·m left the group
+    // {viscous damping, μ}, and the cycles named viscous damping from it). So each group is
+    // separated together with its best single-knob rivals outside it.
+    let with_rivals = |group: &[String]| {
+        let mut g = group.to_vec();
+        g.extend(
+            d.single
+                .iter()
+                .filter(|f| !group.contains(&f.knob))
+                .take(CONFIRM_RIVALS)
+                .map(|f| f.knob.clone()),
+        );
+        g
+    };
+    let mut jobs: Vec<(FollowPurpose, Vec<String>)> = d
+        .answer
         .ambiguous
         .iter()
         .filter(|g| g.len() >= 2)
-        .map(|g| {
-            let o = SeparateOptions {
-                candidates: g.clone(),
-                ..opts.clone()
+        .map(|g| (FollowPurpose::Ambiguous, with_rivals(g)))
+        .collect();
+    let beyond_noise = matches!(
+        d.answer.kind,
+        AnswerKind::PartlyExplained | AnswerKind::Unexplained
+    );
+    if answer_names.is_empty() && beyond_noise {
+        let mut group: Vec<String> = d.answer.leads.iter().map(|n| n.knob.clone()).collect();
+        for f in &d.single {
+            if group.len() >= EXPLORE_CANDIDATES {
+                break;
+            }
+            if !group.contains(&f.knob) {
+                group.push(f.knob.clone());
+            }
+        }
+        if group.len() >= 2 {
+            jobs.push((FollowPurpose::Explore, group));
+        }
+    }
+    if let [knob] = answer_names.as_slice() {
+        let mut group = vec![knob.clone()];
+        group.extend(
+            d.single
+                .iter()
+                .filter(|f| &f.knob != knob)
+                .take(CONFIRM_RIVALS)
+                .map(|f| f.knob.clone()),
+        );
+        if group.len() >= 2 {
+            jobs.push((FollowPurpose::Confirm { knob: knob.clone() }, group));
+        }
+    }
+    for (purpose, group) in jobs {
+        let o = SeparateOptions {
+            candidates: group,
+            ..opts.clone()
+        };
+        let separation = match reference {
+            Some(r) => separate_through(set, conditions, sigs, r, lib, &o, cache, progress)?,
+            None => separate_with(set, conditions, sigs, lib, &o, cache, progress)?,
+        };
+        let verdict = final_verdict(&separation);
+        match (&purpose, &verdict) {
+            (FollowPurpose::Ambiguous | FollowPurpose::Explore, Verdict::Named { knob })
+                if !out.named.contains(knob) =>
+            {
+                out.named.push(knob.clone());
+            }
+            (FollowPurpose::Confirm { knob }, v) if v != &Verdict::Named { knob: knob.clone() } => {
+                out.named.retain(|k| k != knob);
+                out.withdrawn.push(format!(
+                    "{knob}: the logged cycles do not confirm it against its closest rivals ({})",
+                    verdict_words(v)
+                ));
+            }
+            _ => {}
+        }
+        out.groups.push(FollowGroup {
+            purpose,
+            separation,
+            verdict,
+        });
+    }
+    Ok(out)
+}
+
+/// A verdict in a few words.
+pub fn verdict_words(v: &Verdict) -> String {
+    match v {
+        Verdict::NoGap => "no gap".into(),
+        Verdict::Named { knob } => format!("they name {knob}"),
+        Verdict::CannotTell { group } => format!("cannot tell {}", group.join(" from ")),
+        Verdict::NoneFits { rest_in } => format!("none fits; the rest lies in {rest_in}"),
+        Verdict::NotComparable { .. } => {
+            "not comparable: the model walks none of the reference's gaits".into()
+        }
+    }
+}
+
+/// [`follow_up_with`] reading the logs the trials (and the reference's) name.
+pub fn follow_up(
+    d: &super::diagnose::Diagnosis,
+    set: &TrialSet,
+    reference: Option<&TrialSet>,
+    lib: &EffectLibrary,
+    opts: &SeparateOptions,
+    progress: &dyn Observer,
+) -> Result<FollowUp, GapError> {
+    if set.trials.iter().all(|t| t.trajectory.is_none()) {
+        return follow_up_with(
+            d,
+            set,
+            &[],
+            &[],
+            None,
+            lib,
+            opts,
+            &CycleCache::default(),
+            progress,
+        );
+    }
+    let conditions = resolve(set)?;
+    let sigs = measured_signatures(set, &conditions, opts.settle_cycles)?;
+    let cache = CycleCache::default();
+    match reference {
+        Some(r) => {
+            let rc = resolve(r)?;
+            let rs = measured_signatures(r, &rc, opts.settle_cycles)?;
+            let reference = Reference {
+                set: r,
+                conditions: &rc,
+                sigs: &rs,
             };
-            separate_with(set, &conditions, &sigs, lib, &o, &cache, progress)
-        })
-        .collect()
+            follow_up_with(
+                d,
+                set,
+                &conditions,
+                &sigs,
+                Some(&reference),
+                lib,
+                opts,
+                &cache,
+                progress,
+            )
+        }
+        None => follow_up_with(
+            d,
+            set,
+            &conditions,
+            &sigs,
+            None,
+            lib,
+            opts,
+            &cache,
+            progress,
+        ),
+    }
 }

@@ -199,7 +199,9 @@ pub fn run(
                             Verdict::Named { knob } if knob == truth => cell.correct[m] += 1,
                             Verdict::Named { .. } => cell.confused[m] += 1,
                             Verdict::CannotTell { .. } => cell.cannot_tell[m] += 1,
-                            Verdict::NoneFits { .. } => cell.none_fits[m] += 1,
+                            Verdict::NoneFits { .. } | Verdict::NotComparable { .. } => {
+                                cell.none_fits[m] += 1
+                            }
                             Verdict::NoGap => cell.no_gap[m] += 1,
                         }
                     }

@@ -7,7 +7,7 @@ use plotters::prelude::*;
 
 use super::plot::{PlotError, register_font};
 use super::sig;
-use crate::gap::separate::{Ranking, Separation, Verdict};
+use crate::gap::separate::{FollowPurpose, FollowUp, Ranking, Separation, Verdict};
 use crate::gap::suggest::{Suggested, Suggestion};
 use crate::gap::waveform::{FIGURE_BINS, Signal};
 use crate::gap::waveform_bench::WaveformBench;
@@ -29,12 +29,18 @@ fn verdict_text(v: &Verdict) -> String {
             "**none fits**: no candidate reproduces the trials within noise (the best one's rest \
              lies in {rest_in}); nothing is named — the cause may be outside the candidates"
         ),
+        Verdict::NotComparable { why } => {
+            format!("**not comparable**: {why}; nothing is named")
+        }
     }
 }
 
 fn ranking_md(o: &mut String, r: &Ranking) {
     let _ = writeln!(o, "### {}\n", r.evidence.label());
     let _ = writeln!(o, "Answer: {}.\n", verdict_text(&r.verdict));
+    if r.fits.is_empty() {
+        return;
+    }
     let _ = writeln!(
         o,
         "{} observations; nominal χ² {}; best χ² p = {}; over-dispersion {}.\n",
@@ -97,6 +103,49 @@ pub fn separation_md(s: &Separation) -> String {
     for n in &s.notes {
         let _ = writeln!(o, "Note: {n}\n");
     }
+    o
+}
+
+/// What the logged cycles add to a diagnosis: each separation, then the names that stand.
+/// Empty when nothing was separated.
+pub fn follow_up_md(f: &FollowUp) -> String {
+    let mut o = String::new();
+    if f.groups.is_empty() {
+        return o;
+    }
+    for g in &f.groups {
+        match &g.purpose {
+            FollowPurpose::Ambiguous => {
+                o.push_str("\n## The look-alike group, with the logged cycles\n\n")
+            }
+            FollowPurpose::Explore => o.push_str(
+                "\n## The gap the summaries leave, with the logged cycles (the leads and the best \
+                 single knobs)\n\n",
+            ),
+            FollowPurpose::Confirm { knob } => {
+                let _ = write!(
+                    o,
+                    "\n## The named knob ({knob}) against its closest rivals, with the logged \
+                     cycles\n\n"
+                );
+            }
+        }
+        o.push_str(&separation_md(&g.separation));
+    }
+    let _ = writeln!(
+        o,
+        "**With the logged cycles:** {}.{}\n",
+        if f.named.is_empty() {
+            "nothing named".to_string()
+        } else {
+            format!("named {}", f.named.join(", "))
+        },
+        if f.withdrawn.is_empty() {
+            String::new()
+        } else {
+            format!(" Withdrawn: {}.", f.withdrawn.join("; "))
+        }
+    );
     o
 }
 

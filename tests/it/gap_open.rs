@@ -1074,6 +1074,9 @@ fn row(
         gap_before: 1.0,
         gap_after: None,
         walks: 0,
+        logged_trials: 0,
+        cycles: String::new(),
+        cycles_named: String::new(),
     }
 }
 
@@ -1232,6 +1235,74 @@ fn benchmark_scores_count_what_the_rows_say() {
     );
     let cov = get("95 % intervals holding the truth");
     assert_eq!((cov.k, cov.n), (1, 1));
+    assert!(
+        !s.scores.iter().any(|x| x.what.contains("logged cycles")),
+        "no Drake row with logs: no cycles score"
+    );
+}
+
+/// The Drake scores with the logged cycles, on hand-made rows: the names that stand after
+/// the cycles replace the answer's (a name the cycles withdrew no longer counts, a name they
+/// added does); μ named through its parameter in a Drake design is the truth's alias, any
+/// other parameter is another knob; rows without logs are not scored with the cycles.
+#[test]
+fn benchmark_scores_the_drake_answers_with_the_logged_cycles() {
+    let lib = EffectLibrary::bundled().expect("library");
+    let drake = |truth: &str, named: &str, logged: usize, cycles_named: &str| {
+        let mut r = row("drake", truth, "", named, "", "");
+        r.key = format!("drake/{truth}/{named}/{cycles_named}/{logged}");
+        r.logged_trials = logged;
+        r.cycles_named = cycles_named.into();
+        r
+    };
+    let rows = vec![
+        // No effect, nothing named with or without the cycles.
+        drake("", "", 3, ""),
+        // The summaries named the look-alike; the cycles withdrew it: no longer "another".
+        drake("hip_coulomb_friction=0.05", "hip_viscous_damping", 3, ""),
+        // The cycles named the truth in the look-alike group.
+        drake("hip_coulomb_friction=0.05", "", 3, "hip_coulomb_friction"),
+        drake("hip_viscous_damping=0.02", "", 3, "hip_viscous_damping"),
+        // μ through its parameter: the truth; a slope: another knob.
+        drake(
+            "friction_coefficient=0.4",
+            "",
+            3,
+            "mugatu-ref-hc40:contact.friction_mu",
+        ),
+        drake(
+            "friction_coefficient=0.6",
+            "",
+            3,
+            "mugatu-ref-hc40:ground.slope_deg",
+        ),
+        // No logs: scored without the cycles only.
+        drake("hip_viscous_damping=0.02", "hip_viscous_damping", 0, ""),
+    ];
+    let opts = BenchmarkOptions::standard("mugatu").expect("the bundled cases");
+    let s = summarize(&rows, &lib, &opts, Default::default());
+    let get = |what: &str| {
+        let x = s
+            .scores
+            .iter()
+            .find(|x| x.what.starts_with(what))
+            .unwrap_or_else(|| panic!("no score {what}"));
+        (x.k, x.n)
+    };
+    assert_eq!(get("Drake, effect added: that effect named"), (1, 6));
+    assert_eq!(get("Drake, effect added: another effect named"), (1, 6));
+    assert_eq!(
+        get("Drake with logged cycles, no effect added: anything named"),
+        (0, 1)
+    );
+    assert_eq!(
+        get("Drake with logged cycles, effect added: that effect named"),
+        (3, 5)
+    );
+    assert_eq!(
+        get("Drake with logged cycles, effect added: another knob named"),
+        (1, 5)
+    );
 }
 
 /// `survey gap explore`: a walking speed above the Froude limit of walking, v ≤ √(g·L)

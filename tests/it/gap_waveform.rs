@@ -367,3 +367,189 @@ fn separate_names_nothing_on_drake_walks_without_an_added_effect() {
         }
     }
 }
+
+/// `survey gap separate --format json` on a Drake-Lagged file of
+/// `tests/golden/drake/gap-lagged-logs/` through its no-effect trials, summaries at 3 % sd:
+/// the two rankings as JSON (summaries; summaries + waveforms).
+fn separate_drake_through_none(file: &str, candidates: &str) -> Vec<serde_json::Value> {
+    let dir = repo().join("tests/golden/drake/gap-lagged-logs");
+    let trials = dir.join(file);
+    let reference = dir.join("trials-none.csv");
+    let o = survey(&[
+        "gap",
+        "separate",
+        "--trials",
+        trials.to_str().expect("utf-8"),
+        "--reference",
+        reference.to_str().expect("utf-8"),
+        "--candidates",
+        candidates,
+        "--default-sd",
+        "0.03",
+        "--format",
+        "json",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let v: serde_json::Value = serde_json::from_str(&stdout(&o)).expect("json");
+    assert_eq!(v["trials_with_logs"], 3, "the three 1x trials have logs");
+    v["rankings"].as_array().expect("rankings").clone()
+}
+
+/// Another engine, a hip loss added in it: Drake-Lagged's Mugatu with hip Coulomb friction
+/// 0.05 N·m, against the same Drake model without it (`tests/golden/drake/gap-lagged-logs/`,
+/// its README). Drake's hip-torque cycle differs from the project's by 33 % of its RMS, so
+/// the cycles fit only through the reference: there the engines' discrepancy cancels and
+/// the change Drake's friction makes is the change ours makes (correlation 0.996). The
+/// summaries alone do not name Coulomb friction (they name its look-alike, viscous damping,
+/// at 0.015 N·m·s/rad); the cycles name it, at Drake's value within 10 %.
+#[test]
+fn the_cycles_through_drakes_no_effect_trials_name_the_friction_drake_added() {
+    let r = separate_drake_through_none(
+        "trials-hip_coulomb_friction-0.05.csv",
+        "hip_viscous_damping,hip_coulomb_friction",
+    );
+    assert_eq!(r.len(), 2);
+    assert_eq!(r[0]["evidence"], "summaries");
+    assert_ne!(
+        r[0]["verdict"]["knob"], "hip_coulomb_friction",
+        "the summaries alone were not expected to tell the look-alikes apart: {}",
+        r[0]["verdict"]
+    );
+    assert_eq!(r[1]["evidence"], "summaries_and_waveforms");
+    assert_eq!(r[1]["verdict"]["kind"], "named", "{}", r[1]["verdict"]);
+    assert_eq!(r[1]["verdict"]["knob"], "hip_coulomb_friction");
+    let best = &r[1]["fits"][0];
+    assert_eq!(best["knob"], "hip_coulomb_friction");
+    let v = best["value"].as_f64().expect("value");
+    assert!((0.045..=0.055).contains(&v), "fitted {v} N·m, Drake's 0.05");
+}
+
+/// The same with damping (0.006 N·m·s/rad, 1.8× the summaries' identification threshold):
+/// the cycles name viscous damping at Drake's value within 10 %.
+#[test]
+fn the_cycles_through_drakes_no_effect_trials_name_the_damping_drake_added() {
+    let r = separate_drake_through_none(
+        "trials-hip_viscous_damping-0.006.csv",
+        "hip_coulomb_friction,hip_viscous_damping",
+    );
+    assert_eq!(r[1]["verdict"]["kind"], "named", "{}", r[1]["verdict"]);
+    assert_eq!(r[1]["verdict"]["knob"], "hip_viscous_damping");
+    let v = r[1]["fits"][0]["value"].as_f64().expect("value");
+    assert!((0.0054..=0.0066).contains(&v), "fitted {v}, Drake's 0.006");
+}
+
+/// Outside what the rule assumes: Drake lowered the foot–floor μ from 0.8 to 0.4, a cause
+/// that is neither candidate. Through the reference, neither hip loss may be named, on the
+/// summaries or with the cycles.
+#[test]
+fn the_cycles_through_drakes_no_effect_trials_name_no_hip_loss_for_a_floor_change() {
+    for file in [
+        "trials-friction_coefficient-0.4.csv",
+        "trials-soft_ground-6e6.csv",
+    ] {
+        let r = separate_drake_through_none(file, "hip_viscous_damping,hip_coulomb_friction");
+        for ranking in &r {
+            assert_ne!(
+                ranking["verdict"]["kind"], "named",
+                "{file}, {}: {} named",
+                ranking["evidence"], ranking["verdict"]
+            );
+        }
+    }
+}
+
+/// `survey gap diagnose` of a Drake-Lagged file through Drake's no-effect trials, three
+/// candidate effects, the design's parameters as they are, summaries at 3 % sd: the text,
+/// whose last section says what the logged cycles added.
+fn diagnose_drake_through_none(file: &str) -> String {
+    let dir = repo().join("tests/golden/drake/gap-lagged-logs");
+    let o = survey(&[
+        "gap",
+        "diagnose",
+        "--trials",
+        dir.join(file).to_str().expect("utf-8"),
+        "--reference",
+        dir.join("trials-none.csv").to_str().expect("utf-8"),
+        "--effects",
+        "hip_viscous_damping,hip_coulomb_friction,soft_ground",
+        "--no-calibration",
+        "--no-audit-undeclared",
+        "--default-sd",
+        "0.03",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    stdout(&o)
+}
+
+/// An effect added in Drake, named on top of the engine difference: on Drake-Lagged's
+/// summaries, carried through Drake's own no-effect trials, hip viscous damping and hip
+/// Coulomb friction explain the change alike (the answer is "ambiguous", nothing named);
+/// the diagnosis then separates the group with the logged cycles, carried through the
+/// reference's, and names the effect Drake added — for either of the two.
+#[test]
+fn diagnose_through_drakes_no_effect_trials_names_the_hip_loss_drake_added_with_the_cycles() {
+    for (file, truth) in [
+        (
+            "trials-hip_coulomb_friction-0.05.csv",
+            "hip_coulomb_friction",
+        ),
+        ("trials-hip_viscous_damping-0.02.csv", "hip_viscous_damping"),
+    ] {
+        let text = diagnose_drake_through_none(file);
+        assert!(text.contains("**Answer (ambiguous):**"), "{file}: {text}");
+        assert!(
+            text.contains(&format!("**With the logged cycles:** named {truth}.")),
+            "{file}: {text}"
+        );
+    }
+}
+
+/// Outside what the cycles can name: Drake lowered the foot–floor μ (0.8 → 0.4), an effect
+/// outside these candidates whose mark on Drake's gait our model does not share closely. The
+/// summaries leave it unexplained; the cycles, looking at the best single knobs, name
+/// nothing either.
+#[test]
+fn diagnose_through_drakes_no_effect_trials_names_nothing_for_a_cause_outside_the_candidates() {
+    let text = diagnose_drake_through_none("trials-friction_coefficient-0.4.csv");
+    assert!(
+        text.contains("**With the logged cycles:** nothing named."),
+        "{text}"
+    );
+}
+
+/// Where the rule's premise fails: Drake-SAP's Mugatu (`tests/golden/drake/gap-sap-logs/`,
+/// convex friction) walks where the project's Coulomb Mugatu scuffs, at every condition.
+/// Carried through Drake-SAP's no-effect trials, a change would not be its mark on our model,
+/// so the separation refuses ("not comparable": the model walks none of the reference's
+/// gaits) instead of naming a hip loss. Before this check it named hip Coulomb friction for
+/// Drake's added viscous damping, on the summaries and with the cycles.
+#[test]
+fn separate_through_a_reference_the_model_does_not_walk_like_is_not_comparable() {
+    let dir = repo().join("tests/golden/drake/gap-sap-logs");
+    for file in [
+        "trials-hip_viscous_damping-0.02.csv",
+        "trials-hip_coulomb_friction-0.05.csv",
+    ] {
+        let o = survey(&[
+            "gap",
+            "separate",
+            "--trials",
+            dir.join(file).to_str().expect("utf-8"),
+            "--reference",
+            dir.join("trials-none.csv").to_str().expect("utf-8"),
+            "--candidates",
+            "hip_viscous_damping,hip_coulomb_friction",
+            "--default-sd",
+            "0.03",
+            "--format",
+            "json",
+        ]);
+        assert!(o.status.success(), "{}", stderr(&o));
+        let v: serde_json::Value = serde_json::from_str(&stdout(&o)).expect("json");
+        let rankings = v["rankings"].as_array().expect("rankings");
+        assert_eq!(rankings.len(), 1, "{file}: {v}");
+        assert_eq!(rankings[0]["verdict"]["kind"], "not_comparable", "{file}");
+        let why = rankings[0]["verdict"]["why"].as_str().expect("why");
+        assert!(why.contains("L1x-f1x: velocity_mps"), "{file}: {why}");
+    }
+}

@@ -3,7 +3,7 @@
 
 Subcommands (run from the repository root; paths are relative to it):
   walk DESIGN.toml [options]   one walk -> trajectory CSV (project format) + metrics JSON
-  trials CONDITIONS.csv --out TRIALS.csv [--effect ...] [--jobs N]
+  trials CONDITIONS.csv --out TRIALS.csv [--effect ...] [--jobs N] [--logs DIR]
                                one 16-cycle walk per trial condition -> trials CSV
                                (project format, dataset/trials/README.md)
   case NAME [--out FILE]       one elementary case of tests/golden/drake/cases.toml
@@ -320,6 +320,13 @@ def main(argv=None):
     t.add_argument("--approximation", choices=["sap", "similar", "lagged"],
                    help="Drake's discrete contact approximation (default as for walk); lagged "
                         "needs a Hunt-Crossley design")
+    t.add_argument("--logs", metavar="DIR",
+                   help="also write each logged trial's robot log (t_s, hip_angle_deg, "
+                        "roll_deg, pitch_deg, yaw_deg, hip_torque_nm; <= 50 samples per drive "
+                        "cycle) into DIR as <label>.csv, named in the trials' trajectory column "
+                        "(the input of survey gap separate's waveform evidence)")
+    t.add_argument("--log-labels", metavar="L1,L2,...",
+                   help="with --logs: log only these rows (by label; default every row)")
     c = sub.add_parser("case", help="run one elementary case")
     c.add_argument("name")
     c.add_argument("--cases", default="tests/golden/drake/cases.toml")
@@ -341,8 +348,14 @@ def main(argv=None):
 
     if args.cmd == "trials":
         import trials as tz
+        labels = None
+        if args.log_labels:
+            if not args.logs:
+                ap.error("--log-labels needs --logs")
+            labels = [x.strip() for x in args.log_labels.split(",") if x.strip()]
         return tz.run_trials(args.conditions, args.out, args.effect, jobs=args.jobs,
-                             approximation=args.approximation)
+                             approximation=args.approximation, logs=args.logs,
+                             log_labels=labels)
     if args.cmd == "walk":
         do_walk(args.design, leg_length=args.leg_length, mass_law=args.mass_law,
                 contact_scaling=args.contact_scaling, frequency=args.frequency,

@@ -40,6 +40,8 @@ NUMBER_CONDITIONS = ("leg_length_m", "mass_kg", "frequency_hz", "amplitude_deg",
 # The metrics one walk gives (`Metric::SIMULATED`), as `analyze` names them.
 METRICS = ("velocity_mps", "step_frequency_hz", "roll_pp_deg", "pitch_pp_deg", "yaw_pp_deg",
            "peak_torque_nm", "cot")
+# The columns of a robot log (dataset/trials/README.md, "Logs"), as the walk's samples name them.
+LOG_COLUMNS = ("t_s", "hip_angle_deg", "roll_deg", "pitch_deg", "yaw_deg", "hip_torque_nm")
 # Bundled designs (`Design::builtin`).
 BUNDLED = {
     "mugatu": "dataset/walkers/mugatu.toml",
@@ -158,7 +160,7 @@ def _run_row(job):
     """Worker: one trial condition -> metrics (runs in its own process)."""
     import walk as wk
     import harness as hz
-    idx, row, design_path, settings, approximation = job
+    idx, row, design_path, settings, approximation, log = job
     t0 = time.perf_counter()
     torque = row["torque_limit_nm"] if row["torque_limit_nm"] is not None else row["torque_nm"]
     mass_law = row.get("mass_law") or "l2"
@@ -190,8 +192,13 @@ def _run_row(job):
         duration_s=duration, time_step_s=run["dt"],
         walk_speed_threshold_over_sqrt_gl=model.criteria["walk_speed_threshold_over_sqrt_gl"],
         fall=run["fall"], mass_law=mass_law, contact_scaling=contact)
+    log_rows = None
+    if log:
+        factor = hz.auto_decimation(freq, run["dt"], run["record_every"])
+        log_rows = [[s[k] for k in LOG_COLUMNS] for s in wk.decimate(run["samples"], factor)]
     return {
         "index": idx, "report": report, "fall": run["fall"], "effects": model.effects,
+        "log": log_rows,
         "wall_s": time.perf_counter() - t0, "walk_wall_s": run["wall_s"],
         "simulated_s": run["simulated_s"], "steps": run["steps"], "dt": run["dt"],
     }
@@ -213,9 +220,26 @@ def _design_cell(name: str, cond_dir: Path, out_dir: Path) -> str:
     return Path(os.path.relpath(p, out_dir.resolve())).as_posix()
 
 
-def run_trials(conditions, out, effect_args, jobs: int = 2, approximation=None) -> int:
+def _log_name(label: str) -> str:
+    """A row's label as a file name: characters other than letters, digits, '.', '_' and '-'
+    become '_'."""
+    return "".join(ch if ch.isalnum() or ch in "._-" else "_" for ch in label) + ".csv"
+
+
+def _log_text(rows) -> str:
+    """A robot log (dataset/trials/README.md, "Logs"): the columns a small walker records,
+    7 significant digits (far below the 0.3 deg / 3 % sensor noise the benchmark adds)."""
+    lines = [",".join(LOG_COLUMNS)]
+    for r in rows:
+        lines.append(",".join(f"{v:.7g}" for v in r))
+    return "\n".join(lines) + "\n"
+
+
+def run_trials(conditions, out, effect_args, jobs: int = 2, approximation=None, logs=None,
+               log_labels=None) -> int:
     """approximation: Drake's discrete contact approximation (None: sap for a relaxation-time
-    design, similar for a Hunt-Crossley one; 'lagged' is the non-convex one)."""
+    design, similar for a Hunt-Crossley one; 'lagged' is the non-convex one). logs: a folder
+    for the rows' robot logs (log_labels: only these rows; None: every row)."""
     import harness as hz
     t_start = time.perf_counter()
     cond_path = Path(conditions)
@@ -235,9 +259,27 @@ def run_trials(conditions, out, effect_args, jobs: int = 2, approximation=None) 
     if approximation is not None:
         command += f" --approximation {approximation}"
     command += " --out " + hz.rel(out_path)
+    if logs is not None:
+        command += " --logs " + hz.rel(Path(logs))
+        if log_labels:
+            command += " --log-labels " + ",".join(log_labels)
     source = f"{command} (Drake {hz.drake_version()})"
     n = len(rows)
-    jobs_list = [(i, r, str(p), settings, approximation)
+    labels = [r.get("label") or "" for r in rows]
+    if log_labels:
+        unknown = [x for x in log_labels if x not in labels]
+        if unknown:
+            raise TrialsError(f"--log-labels: no row of {cond_path} is labelled "
+                              + ", ".join(unknown))
+    if logs is not None:
+        missing = [r["_line"] for r in rows if not r.get("label")]
+        if missing:
+            raise TrialsError(f"--logs: rows without a label (lines {missing}) cannot name a log")
+        names = [_log_name(x) for x in labels]
+        if len(set(names)) != len(names):
+            raise TrialsError(f"--logs: two rows of {cond_path} give the same log file name")
+    logged = [logs is not None and (not log_labels or x in log_labels) for x in labels]
+    jobs_list = [(i, r, str(p), settings, approximation, logged[i])
                  for i, (r, p) in enumerate(zip(rows, designs))]
     print(f"{n} trials, {max(1, jobs)} processes; effects: "
           + (", ".join(effect_args) if effect_args else "none"), flush=True)
@@ -291,10 +333,23 @@ def run_trials(conditions, out, effect_args, jobs: int = 2, approximation=None) 
         cells["mass_law"] = row.get("mass_law", "") or ""
         cells["contact"] = row.get("contact", "") or ""
         cells.update(_metric_cells(res, is_fall))
+        if res["log"] is not None and not is_fall:
+            log_path = Path(logs).resolve() / _log_name(cells["label"])
+            cells["trajectory"] = Path(os.path.relpath(log_path, out_dir)).as_posix()
         cells["source"] = (source + f"; the walk fell ({res['fall'][0]} at "
                            f"{fmt_number(round(res['fall'][1], 6))} s): nothing measured"
                            if is_fall else source)
         w.writerow([cells[h] for h in HEADER])
+    if logs is not None:
+        # Logs first, each atomically: the trials file that names them comes last.
+        Path(logs).mkdir(parents=True, exist_ok=True)
+        for row, res in zip(rows, results):
+            if res["log"] is None or res["fall"] is not None:
+                continue
+            lp = Path(logs) / _log_name(row["label"])
+            ltmp = lp.with_name("." + lp.name + ".tmp")
+            ltmp.write_text(_log_text(res["log"]))
+            os.replace(ltmp, lp)
     out_path.parent.mkdir(parents=True, exist_ok=True)
     tmp = out_path.with_name("." + out_path.name + ".tmp")
     tmp.write_text(buf.getvalue())
