@@ -22,10 +22,12 @@
 //!   [`diagnose`]: the answer;
 //!   [`locate`]: where the gap lies; [`identify`]: detection and identification thresholds;
 //!   [`reference`]: trials carried onto the model through a reference set of the same
-//!   robot (`--reference`: the diagnosis of what changed between them).
+//!   robot (`--reference`: the diagnosis of what changed between them), their logged cycles
+//!   too, where the model walks the reference's gait.
 //! * [`waveform`]: a robot's log (time, hip angle, attitude, torque) reduced to the Fourier
 //!   coefficients of its steady cycle, and their χ² against a simulated cycle;
-//!   [`separate`]: look-alike candidates ranked on summaries and on summaries + cycles;
+//!   [`separate`]: look-alike candidates ranked on summaries and on summaries + cycles, and
+//!   a diagnosis's answer followed by the cycles (`follow_up`);
 //!   [`suggest`]: the next trials that best separate the two leading candidates.
 //! * [`synth`]: "real" trials simulated with withheld effects or wrong parameters plus noise
 //!   (and robot logs).
