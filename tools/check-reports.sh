@@ -83,6 +83,8 @@ drake_reference() { # folder name, seeds (default 3)
 for name in lagged lagged-next lagged-heldout; do drake_reference "$name"; done
 # The same with the 1x trials' robot logs: the diagnosis followed by the logged cycles.
 drake_reference lagged-logs 5
+# The same rules on Drake trials with logs made after them (other magnitudes; twentieth session).
+drake_reference lagged-logs-heldout 5
 # Drake-SAP's trials against mugatu-ref-sap (the convex friction cone), plain and through the
 # no-effect trials: with the signed velocity (eighteenth session) and compared on speed
 # (criteria.walking_direction = "either"; nineteenth session, four of the nine files).
