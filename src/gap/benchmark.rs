@@ -1729,65 +1729,68 @@ fn parameter_scores(rows: &[CaseRow], scores: &mut Vec<Score>) {
 }
 
 /// Drake trials: an effect blamed without one added; with one added, it named and
-/// another named.
+/// another named — on the answers, and again on the names that stand after the logged
+/// cycles where the trials have logs.
 fn drake_scores(rows: &[CaseRow], aliases: &BTreeMap<String, String>, scores: &mut Vec<Score>) {
-    let drake: Vec<&CaseRow> = rows.iter().filter(|r| r.kind == "drake").collect();
+    let drake: Vec<CaseRow> = rows.iter().filter(|r| r.kind == "drake").cloned().collect();
     if drake.is_empty() {
         return;
     }
-    let nulls: Vec<&&CaseRow> = drake
-        .iter()
-        .filter(|r| r.truth_effects.is_empty())
-        .collect();
-    scores.push(score(
-        "Drake, no effect added: an effect blamed",
-        nulls.iter().filter(|r| effect_named(r)).count(),
-        nulls.len(),
-        "0 %",
-    ));
-    let with: Vec<&&CaseRow> = drake
-        .iter()
-        .filter(|r| !r.truth_effects.is_empty())
-        .collect();
-    scores.push(score(
-        "Drake, effect added: that effect named (on top of the engine difference)",
-        with.iter()
-            .filter(|r| names_every_truth_effect(r, aliases))
-            .count(),
-        with.len(),
-        "high",
-    ));
-    scores.push(score(
-        "Drake, effect added: another effect named",
-        with.iter().filter(|r| names_other_effect(r)).count(),
-        with.len(),
-        "low",
-    ));
+    drake_rates(
+        &drake,
+        [
+            "Drake, no effect added: an effect blamed",
+            "Drake, effect added: that effect named (on top of the engine difference)",
+            "Drake, effect added: another effect named",
+        ],
+        &effect_named,
+        &names_other_effect,
+        aliases,
+        scores,
+    );
     // With the logged cycles: the same questions of the names that stand after them.
     let logged: Vec<CaseRow> = drake
         .iter()
         .filter(|r| r.logged_trials > 0)
-        .map(|r| with_cycles(r))
+        .map(with_cycles)
         .collect();
     if logged.is_empty() {
         return;
     }
-    let nulls: Vec<&CaseRow> = logged
-        .iter()
-        .filter(|r| r.truth_effects.is_empty())
-        .collect();
+    drake_rates(
+        &logged,
+        [
+            "Drake with logged cycles, no effect added: anything named (the answer with the cycles)",
+            "Drake with logged cycles, effect added: that effect named (the answer with the cycles)",
+            "Drake with logged cycles, effect added: another knob named (the answer with the cycles)",
+        ],
+        &any_named,
+        &|r| names_other_knob(r, aliases),
+        aliases,
+        scores,
+    );
+}
+
+/// The three Drake rates of `rows` under `labels`: a null case blamed (`blamed`), the added
+/// effect named, another named (`other`).
+fn drake_rates(
+    rows: &[CaseRow],
+    labels: [&str; 3],
+    blamed: &dyn Fn(&CaseRow) -> bool,
+    other: &dyn Fn(&CaseRow) -> bool,
+    aliases: &BTreeMap<String, String>,
+    scores: &mut Vec<Score>,
+) {
+    let (nulls, with): (Vec<&CaseRow>, Vec<&CaseRow>) =
+        rows.iter().partition(|r| r.truth_effects.is_empty());
     scores.push(score(
-        "Drake with logged cycles, no effect added: anything named (the answer with the cycles)",
-        nulls.iter().filter(|r| any_named(r)).count(),
+        labels[0],
+        nulls.iter().filter(|r| blamed(r)).count(),
         nulls.len(),
         "0 %",
     ));
-    let with: Vec<&CaseRow> = logged
-        .iter()
-        .filter(|r| !r.truth_effects.is_empty())
-        .collect();
     scores.push(score(
-        "Drake with logged cycles, effect added: that effect named (the answer with the cycles)",
+        labels[1],
         with.iter()
             .filter(|r| names_every_truth_effect(r, aliases))
             .count(),
@@ -1795,8 +1798,8 @@ fn drake_scores(rows: &[CaseRow], aliases: &BTreeMap<String, String>, scores: &m
         "high",
     ));
     scores.push(score(
-        "Drake with logged cycles, effect added: another knob named (the answer with the cycles)",
-        with.iter().filter(|r| names_other_knob(r, aliases)).count(),
+        labels[2],
+        with.iter().filter(|r| other(r)).count(),
         with.len(),
         "low",
     ));

@@ -377,16 +377,22 @@ fn separate_drake_through_none(file: &str, candidates: &str) -> Vec<serde_json::
 
 /// The same in another folder of `tests/golden/drake/`.
 fn separate_drake_in(folder: &str, file: &str, candidates: &str) -> Vec<serde_json::Value> {
+    let v = separate_drake_json(folder, file, candidates);
+    assert_eq!(v["trials_with_logs"], 3, "the three 1x trials have logs");
+    v["rankings"].as_array().expect("rankings").clone()
+}
+
+/// `survey gap separate --format json` of `tests/golden/drake/<folder>/<file>` through the
+/// folder's `trials-none.csv`, summaries at 3 % sd: the whole answer.
+fn separate_drake_json(folder: &str, file: &str, candidates: &str) -> serde_json::Value {
     let dir = repo().join("tests/golden/drake").join(folder);
-    let trials = dir.join(file);
-    let reference = dir.join("trials-none.csv");
     let o = survey(&[
         "gap",
         "separate",
         "--trials",
-        trials.to_str().expect("utf-8"),
+        dir.join(file).to_str().expect("utf-8"),
         "--reference",
-        reference.to_str().expect("utf-8"),
+        dir.join("trials-none.csv").to_str().expect("utf-8"),
         "--candidates",
         candidates,
         "--default-sd",
@@ -395,9 +401,7 @@ fn separate_drake_in(folder: &str, file: &str, candidates: &str) -> Vec<serde_js
         "json",
     ]);
     assert!(o.status.success(), "{}", stderr(&o));
-    let v: serde_json::Value = serde_json::from_str(&stdout(&o)).expect("json");
-    assert_eq!(v["trials_with_logs"], 3, "the three 1x trials have logs");
-    v["rankings"].as_array().expect("rankings").clone()
+    serde_json::from_str(&stdout(&o)).expect("json")
 }
 
 /// Another engine, a hip loss added in it: Drake-Lagged's Mugatu with hip Coulomb friction
@@ -579,27 +583,15 @@ fn held_out_two_hip_losses_at_once_are_not_named_as_one() {
 /// Drake's added viscous damping, on the summaries and with the cycles.
 #[test]
 fn separate_through_a_reference_the_model_does_not_walk_like_is_not_comparable() {
-    let dir = repo().join("tests/golden/drake/gap-sap-logs");
     for file in [
         "trials-hip_viscous_damping-0.02.csv",
         "trials-hip_coulomb_friction-0.05.csv",
     ] {
-        let o = survey(&[
-            "gap",
-            "separate",
-            "--trials",
-            dir.join(file).to_str().expect("utf-8"),
-            "--reference",
-            dir.join("trials-none.csv").to_str().expect("utf-8"),
-            "--candidates",
+        let v = separate_drake_json(
+            "gap-sap-logs",
+            file,
             "hip_viscous_damping,hip_coulomb_friction",
-            "--default-sd",
-            "0.03",
-            "--format",
-            "json",
-        ]);
-        assert!(o.status.success(), "{}", stderr(&o));
-        let v: serde_json::Value = serde_json::from_str(&stdout(&o)).expect("json");
+        );
         let rankings = v["rankings"].as_array().expect("rankings");
         assert_eq!(rankings.len(), 1, "{file}: {v}");
         assert_eq!(rankings[0]["verdict"]["kind"], "not_comparable", "{file}");
