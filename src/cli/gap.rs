@@ -545,7 +545,9 @@ pub struct BenchmarkArgs {
     /// Noise levels (relative sd) of the null and single-effect cases.
     #[arg(long, value_delimiter = ',')]
     pub noise: Option<Vec<f64>>,
-    /// Folder of Drake trials files (`trials-*.csv`, e.g. tests/golden/drake/gap).
+    /// Folder of Drake trials files (`trials-*.csv`, e.g. tests/golden/drake/gap), each named
+    /// by what Drake added: trials-none.csv, trials-<effect>-<value>.csv, or several effects
+    /// joined by `+` (trials-hip_viscous_damping-0.01+hip_coulomb_friction-0.03.csv).
     #[arg(long, value_name = "DIR")]
     pub drake: Option<PathBuf>,
     /// Diagnose each Drake case relative to a noisy copy of the folder's `trials-none.csv`

@@ -176,10 +176,11 @@ pub enum Truth {
         params: Vec<(String, f64)>,
         effects: Vec<(String, f64)>,
     },
-    /// A Drake trials file (exact metrics) and the effect added in Drake, if any.
+    /// A Drake trials file (exact metrics) and the effects added in Drake: none, one, or
+    /// several at once (`trials-<effect>-<value>+<effect>-<value>.csv`).
     Drake {
         file: String,
-        effect: Option<(String, f64)>,
+        effects: Vec<(String, f64)>,
     },
 }
 
@@ -830,8 +831,8 @@ impl Planner<'_> {
 /// Drake's no-effect trials (the file's stem), the reference of `--drake-reference`.
 const DRAKE_NONE: &str = "trials-none";
 
-/// The Drake cases: every `trials-*.csv` of `dir` (named `trials-<effect>-<value>` when
-/// Drake added an effect), `drake_seeds` noisy copies each. Returns the truths by file.
+/// The Drake cases: every `trials-*.csv` of `dir` (named by the effects Drake added,
+/// [`drake_effects`]), `drake_seeds` noisy copies each. Returns the truths by file.
 fn drake_cases(
     opts: &BenchmarkOptions,
     dir: &Path,
@@ -873,10 +874,13 @@ fn drake_cases(
             .and_then(|s| s.to_str())
             .unwrap_or("")
             .to_string();
-        let effect = name
-            .strip_prefix("trials-")
-            .and_then(|rest| rest.rsplit_once('-'))
-            .and_then(|(e, v)| Some((e.to_string(), v.parse::<f64>().ok()?)));
+        let effects = drake_effects(&name).ok_or_else(|| GapError::File {
+            path: f.display().to_string(),
+            message: format!(
+                "a Drake trials file is named {DRAKE_NONE}.csv or \
+                 trials-<effect>-<value>[+<effect>-<value>…].csv (the effects Drake added)"
+            ),
+        })?;
         // One suite serves every Drake file: its conditions must be the first file's.
         if let Some(first) = drake.values().next()
             && !same_conditions(&first.set, &set)?
@@ -912,13 +916,30 @@ fn drake_cases(
                 multiple: None,
                 truth: Truth::Drake {
                     file: name.clone(),
-                    effect: effect.clone(),
+                    effects: effects.clone(),
                 },
             });
         }
         drake.insert(name, DrakeFile { set, truth, logs });
     }
     Ok(drake)
+}
+
+/// The effects Drake added to a trials file, from its stem: `trials-none` none,
+/// `trials-<effect>-<value>` one, `+` between several; `None` for any other name. Effect
+/// names are snake_case, so the first `-` ends the name (a value may hold one: `1e-3`).
+fn drake_effects(stem: &str) -> Option<Vec<(String, f64)>> {
+    let rest = stem.strip_prefix("trials-")?;
+    if stem == DRAKE_NONE {
+        return Some(Vec::new());
+    }
+    rest.split('+')
+        .map(|part| {
+            let (effect, value) = part.split_once('-')?;
+            let value = value.parse::<f64>().ok().filter(|v| v.is_finite())?;
+            (!effect.is_empty()).then(|| (effect.to_string(), value))
+        })
+        .collect()
 }
 
 /// The specification line of a benchmark's points file.
@@ -1219,11 +1240,7 @@ impl CaseRow {
                         .iter()
                         .all(|(p, _)| design.uncertain.iter().any(|u| &u.path == p)),
             ),
-            Truth::Drake { effect, .. } => (
-                pairs(&effect.iter().cloned().collect::<Vec<_>>()),
-                String::new(),
-                false,
-            ),
+            Truth::Drake { effects, .. } => (pairs(effects), String::new(), false),
         };
         CaseRow {
             key: case.key.clone(),
@@ -1947,7 +1964,39 @@ fn confusions(rows: &[CaseRow], noise_levels: &[f64]) -> Vec<Confusion> {
 
 #[cfg(test)]
 mod tests {
-    use super::interval_holds;
+    use super::{drake_effects, interval_holds};
+
+    /// A Drake file's stem names what Drake added; any other name is refused, not taken for
+    /// a file with no effect.
+    #[test]
+    fn a_drake_file_name_gives_the_effects_drake_added() {
+        assert_eq!(drake_effects("trials-none"), Some(vec![]));
+        assert_eq!(
+            drake_effects("trials-soft_ground-6e6"),
+            Some(vec![("soft_ground".into(), 6e6)])
+        );
+        assert_eq!(
+            drake_effects("trials-hip_viscous_damping-0.01+hip_coulomb_friction-0.03"),
+            Some(vec![
+                ("hip_viscous_damping".into(), 0.01),
+                ("hip_coulomb_friction".into(), 0.03)
+            ])
+        );
+        assert_eq!(
+            drake_effects("trials-hip_backlash-1e-3"),
+            Some(vec![("hip_backlash".into(), 1e-3)])
+        );
+        for bad in [
+            "trials-nothing",
+            "trials-x-",
+            "trials--1",
+            "trials-a-1+",
+            "trials-a-nan",
+            "none",
+        ] {
+            assert_eq!(drake_effects(bad), None, "{bad}");
+        }
+    }
 
     /// A magnitude's interval holds a truth of either sign; a signed one only its own.
     #[test]

@@ -566,7 +566,7 @@ fn held_out_the_cycles_name_drakes_large_hip_friction_the_summaries_call_damping
 fn held_out_two_hip_losses_at_once_are_not_named_as_one() {
     let text = diagnose_drake_in(
         "gap-lagged-logs-heldout",
-        "compound-hip_viscous_damping-0.01+hip_coulomb_friction-0.03.csv",
+        "trials-hip_viscous_damping-0.01+hip_coulomb_friction-0.03.csv",
     );
     assert!(text.contains("**Answer (ambiguous):**"), "{text}");
     assert!(
