@@ -479,6 +479,14 @@ pub fn plan(
         .map(|e| e.name.clone())
         .collect();
 
+    // The Drake files are read (and their names, conditions and logs checked) before the
+    // minutes the thresholds take: a bad file fails at once.
+    let mut drake_specs = Vec::new();
+    let drake = match &opts.drake_dir {
+        Some(dir) => drake_cases(opts, dir, &mut drake_specs)?,
+        None => BTreeMap::new(),
+    };
+
     progress.stage("default conditions");
     let main = Suite::new(
         "main",
@@ -503,18 +511,15 @@ pub fn plan(
         suites.push(planner.one_robot_cases()?);
     }
     let mut cases = planner.cases;
-    let mut drake = BTreeMap::new();
-    if let Some(dir) = &opts.drake_dir {
-        drake = drake_cases(opts, dir, &mut cases)?;
-        if let Some(first) = drake.values().next() {
-            let mut base = first.set.clone();
-            for t in base.trials.iter_mut() {
-                t.measured = [None; 8];
-                // Each case's logs are its file's, in memory (`DrakeFile::logs`).
-                t.trajectory = None;
-            }
-            suites.push(Suite::new("drake", base)?);
+    cases.append(&mut drake_specs);
+    if let Some(first) = drake.values().next() {
+        let mut base = first.set.clone();
+        for t in base.trials.iter_mut() {
+            t.measured = [None; 8];
+            // Each case's logs are its file's, in memory (`DrakeFile::logs`).
+            t.trajectory = None;
         }
+        suites.push(Suite::new("drake", base)?);
     }
     // Two multiples of a threshold clamped to the same end of an effect's range make the
     // same truth: one case (the key is the truth), not two rows that collide.

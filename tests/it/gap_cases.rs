@@ -204,3 +204,44 @@ fn a_narrowed_benchmark_needs_an_out_folder() {
     );
     assert_eq!(std::fs::read_to_string(&report).expect("read"), before);
 }
+
+/// A Drake trials file whose name does not say what Drake added is refused, naming it,
+/// before any walk (it used to be taken for a file with no effect: a null case whose truth
+/// nobody knew), and nothing is written.
+#[test]
+fn a_drake_file_not_named_by_its_effects_is_refused_at_once() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let drake = dir.path().join("drake");
+    std::fs::create_dir(&drake).expect("mkdir");
+    let none = repo().join("tests/golden/drake/gap-lagged/trials-none.csv");
+    let designs = repo().join("tests/golden/drake/designs/");
+    let text = std::fs::read_to_string(&none)
+        .expect("golden trials")
+        .replace("../designs/", designs.to_str().expect("utf-8"));
+    std::fs::write(drake.join("trials-none.csv"), &text).expect("write");
+    std::fs::write(drake.join("trials-softer.csv"), &text).expect("write");
+    let out_dir = dir.path().join("out");
+    let points = dir.path().join("points.csv");
+    let out = survey(&[
+        "gap",
+        "benchmark",
+        "--design",
+        "mugatu",
+        "--quick",
+        "--drake",
+        drake.to_str().expect("utf-8"),
+        "--kinds",
+        "drake",
+        "--points",
+        points.to_str().expect("utf-8"),
+        "--out",
+        out_dir.to_str().expect("utf-8"),
+    ]);
+    assert!(!out.status.success());
+    let e = stderr(&out);
+    assert!(
+        e.contains("trials-softer.csv") && e.contains("trials-<effect>-<value>"),
+        "{e}"
+    );
+    assert!(!out_dir.exists() && !points.exists(), "nothing written");
+}
