@@ -1184,35 +1184,17 @@ fn drake_cycles(
         &suite.cycles,
         &Silent,
     )?;
-    if std::env::var("GAP_DEBUG").is_ok() {
-        for g in &f.groups {
-            for r in &g.separation.rankings {
-                eprintln!(
-                    "{} {:?} {:?} phi {:.2} n {}",
-                    case.key, r.evidence, r.verdict, r.overdispersion, r.observations
-                );
-                for c in &r.fits {
-                    eprintln!(
-                        "   {} {:.4} s {:.1} w {:.1} d {:.2}",
-                        c.knob, c.value, c.chi2_summaries, c.chi2_waveforms, c.delta
-                    );
-                }
-            }
-            for n in &g.separation.notes {
-                eprintln!("   note: {n}");
-            }
-        }
-    }
     let said = f
         .groups
         .iter()
         .map(|g| {
-            let (purpose, group) = match &g.purpose {
-                FollowPurpose::Ambiguous => ("ambiguous", &g.separation),
-                FollowPurpose::Confirm { .. } => ("confirm", &g.separation),
-                FollowPurpose::Explore => ("explore", &g.separation),
+            let purpose = match &g.purpose {
+                FollowPurpose::Ambiguous => "ambiguous",
+                FollowPurpose::Confirm { .. } => "confirm",
+                FollowPurpose::Explore => "explore",
             };
-            let candidates: Vec<String> = group
+            let candidates: Vec<String> = g
+                .separation
                 .rankings
                 .first()
                 .map(|r| r.fits.iter().map(|c| c.knob.clone()).collect())

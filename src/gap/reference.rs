@@ -25,7 +25,7 @@ use super::fit::{Fit, FitContext};
 use super::select::{Step, within_noise};
 use super::simulate::{Condition, SimMetrics};
 use super::trials::{Measurement, Metric, Trial, TrialSet};
-use super::waveform::{CycleSignature, FIGURE_BINS, SignalCycle, evaluate};
+use super::waveform::{CycleSignature, SignalCycle};
 
 /// The carried trials and what the carrying did, in words.
 #[derive(Clone, Debug)]
@@ -237,7 +237,8 @@ pub fn like_gait(
 /// A logged cycle carried onto the nominal model as the summaries are ([`carry`]): each
 /// Fourier coefficient becomes `nominal + (trial − reference)`, its sd the three means' own
 /// (cycle-to-cycle spread / √cycles of the trial, the reference and the nominal walk) and the
-/// carrying's, |change| · ρ with ρ = |rms_reference − rms_nominal| / rms_reference per signal:
+/// carrying's ([`form_sd`] of the signal's RMS: |change| · ρ, ρ = |rms_reference − rms_nominal| /
+/// rms_reference):
 /// had the discrepancy been a gain (the robot's cycle a scaled copy of the model's), the change
 /// would have been scaled by rms_nominal / rms_reference. A discrepancy of *shape* (a phase,
 /// other harmonics) cancels in the difference and is not charged. Measured on Drake-Lagged's
@@ -262,11 +263,6 @@ pub fn carry_cycles(
         if r.coefficients.len() != k || n.coefficients.len() != k {
             continue;
         }
-        let rho = if r.rms > 0.0 {
-            ((r.rms - n.rms) / r.rms).abs().min(1.0)
-        } else {
-            1.0
-        };
         let mean_var =
             |c: &SignalCycle, cycles: usize, i: usize| c.spread[i].powi(2) / cycles.max(1) as f64;
         let mut coefficients = Vec::with_capacity(k);
@@ -282,21 +278,15 @@ pub fn carry_cycles(
             let var = mean_var(t, trial.cycles, i)
                 + mean_var(r, reference.cycles, i)
                 + mean_var(n, nominal.cycles, i)
-                + (change * rho).powi(2);
+                + form_sd(change, r.rms, n.rms).powi(2);
             coefficients.push(value);
             spread.push(var.sqrt());
         }
-        let rms = (coefficients[1..].iter().map(|a| a * a).sum::<f64>() / 2.0).sqrt();
-        let cycle = (0..FIGURE_BINS)
-            .map(|b| evaluate(&coefficients, (b as f64 + 0.5) / FIGURE_BINS as f64))
-            .collect();
-        signals.push(SignalCycle {
-            signal: t.signal,
+        signals.push(SignalCycle::from_coefficients(
+            t.signal,
             coefficients,
             spread,
-            rms,
-            cycle,
-        });
+        ));
     }
     (!signals.is_empty()).then_some(CycleSignature {
         drive_frequency_hz: trial.drive_frequency_hz,
@@ -384,7 +374,7 @@ pub fn rivals_within_noise(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::gap::waveform::Signal;
+    use crate::gap::waveform::{FIGURE_BINS, Signal};
 
     /// A signal whose coefficients are `head` then zeros, with the same spread everywhere
     /// and the RMS of its cycle about its mean (Parseval: √(Σ_{k≥1} c²/2)).

@@ -208,6 +208,15 @@ pub fn measured_signatures(
         .collect()
 }
 
+/// A trial set's resolved conditions and the cycles measured from the logs its rows name.
+type Resolved = (Vec<Condition>, Vec<Option<CycleSignature>>);
+
+fn resolve_with_cycles(set: &TrialSet, settle_cycles: usize) -> Result<Resolved, GapError> {
+    let conditions = resolve(set)?;
+    let sigs = measured_signatures(set, &conditions, settle_cycles)?;
+    Ok((conditions, sigs))
+}
+
 /// Separates the candidates on the trials of `set`, reading the logs its rows name.
 pub fn separate(
     set: &TrialSet,
@@ -216,8 +225,7 @@ pub fn separate(
     progress: &dyn Observer,
 ) -> Result<Separation, GapError> {
     check(opts)?;
-    let conditions = resolve(set)?;
-    let sigs = measured_signatures(set, &conditions, opts.settle_cycles)?;
+    let (conditions, sigs) = resolve_with_cycles(set, opts.settle_cycles)?;
     separate_with(
         set,
         &conditions,
@@ -237,15 +245,31 @@ pub struct Reference<'a> {
     pub sigs: &'a [Option<CycleSignature>],
 }
 
-/// [`separate_with`] on what changed between `reference` and `set`: the summaries carried
-/// onto the nominal model as `gap diagnose --reference` carries them
-/// ([`super::reference::carry`]), and each logged cycle likewise
-/// ([`super::reference::carry_cycles`]), so that a discrepancy the model has at every
-/// condition (another engine's contact, an unmodelled structure) cancels in both kinds of
-/// evidence. A trial's cycles are carried only where the trial, its reference trial and the
-/// nominal walk all have them.
+/// What changed between a reference and a trial set, carried onto the nominal model
+/// ([`carry_through`]): made once, whatever the candidates separated on it.
+struct Carrying {
+    /// The carried summaries (a trial where the model does not walk the reference's gait
+    /// has none).
+    set: TrialSet,
+    /// The carried cycles.
+    sigs: Vec<Option<CycleSignature>>,
+    /// Why nothing could be carried: the model walks none of the reference's gaits.
+    not_comparable: Option<String>,
+    notes: Vec<String>,
+    trials_with_logs: usize,
+    /// The nominal walks made to carry (not found in the cache).
+    walks: usize,
+}
+
+/// Carries `set` and its cycles (`sigs`) onto the nominal model through `reference`: the
+/// summaries as `gap diagnose --reference` carries them ([`super::reference::carry`]), each
+/// logged cycle likewise ([`super::reference::carry_cycles`]), so that a discrepancy the
+/// model has at every condition (another engine's contact, an unmodelled structure) cancels
+/// in both kinds of evidence. Only where the model walks the reference's gait
+/// ([`super::reference::like_gait`]) is a trial carried; a trial's cycles only where the
+/// trial, its reference trial and the nominal walk all have them.
 #[allow(clippy::too_many_arguments)]
-pub fn separate_through(
+fn carry_through(
     set: &TrialSet,
     conditions: &[Condition],
     sigs: &[Option<CycleSignature>],
@@ -254,8 +278,7 @@ pub fn separate_through(
     opts: &SeparateOptions,
     cache: &CycleCache,
     progress: &dyn Observer,
-) -> Result<Separation, GapError> {
-    check(opts)?;
+) -> Result<Carrying, GapError> {
     if sigs.len() != set.trials.len() || reference.sigs.len() != reference.set.trials.len() {
         return Err(GapError::Invalid(format!(
             "{}: {} trials but {} cycle signatures; reference {}: {} trials but {}",
@@ -288,75 +311,71 @@ pub fn separate_through(
         &nominal_metrics,
         opts.default_relative_sd,
     )?;
-    // Only where the model walks the reference's gait is the change carried (both kinds of
-    // evidence); elsewhere the trial is left out, with why.
-    let mut carried_set = carried.set;
-    let mut unlike: Vec<String> = Vec::new();
-    let like: Vec<bool> = conditions
+    // Each trial's reference trial, once (`carry` has checked that every trial has one).
+    let reference_index: Vec<Option<usize>> = conditions
         .iter()
-        .zip(nominal.iter())
-        .zip(&set.trials)
-        .map(|((c, nom), t)| {
-            let r = reference
+        .map(|c| {
+            reference
                 .conditions
                 .iter()
                 .position(|rc| super::reference::same_condition(c, rc))
-                .map(|j| &filled_reference.trials[j]);
-            match r.map(|r| super::reference::like_gait(r, &nom.metrics, opts.default_relative_sd))
-            {
-                Some(Ok(())) | None => true,
-                Some(Err(why)) => {
-                    unlike.push(format!("{}: {why}", t.name()));
-                    false
-                }
-            }
         })
         .collect();
+    // Only where the model walks the reference's gait is the change carried (both kinds of
+    // evidence); elsewhere the trial is left out, with why.
+    let mut unlike: Vec<String> = Vec::new();
+    let like: Vec<bool> = reference_index
+        .iter()
+        .zip(nominal.iter())
+        .zip(&set.trials)
+        .map(|((j, nom), t)| {
+            let verdict = j.map(|j| {
+                super::reference::like_gait(
+                    &filled_reference.trials[j],
+                    &nom.metrics,
+                    opts.default_relative_sd,
+                )
+            });
+            if let Some(Err(why)) = verdict {
+                unlike.push(format!("{}: {why}", t.name()));
+                return false;
+            }
+            true
+        })
+        .collect();
+    let mut carried_set = carried.set;
     for (t, &ok) in carried_set.trials.iter_mut().zip(&like) {
         if !ok {
             t.measured = [None; 8];
         }
     }
+    let mut notes = carried.notes;
+    let trials_with_logs = sigs.iter().filter(|s| s.is_some()).count();
     if !like.iter().any(|&l| l) {
         let why = format!(
             "the nominal model walks none of the reference trials' gaits ({}): a change \
              carried onto it would not be its mark on the model",
             unlike.join("; ")
         );
-        let mut notes = carried.notes;
         notes.push(why.clone());
-        return Ok(Separation {
-            trials: set.trials.len(),
-            trials_with_logs: sigs.iter().filter(|s| s.is_some()).count(),
-            relative_floor: opts.relative_floor,
-            alpha: opts.alpha,
-            rankings: vec![Ranking {
-                evidence: Evidence::Summaries,
-                fits: Vec::new(),
-                nominal_chi2: f64::NAN,
-                observations: 0,
-                overdispersion: 1.0,
-                best_p_value: f64::NAN,
-                verdict: Verdict::NotComparable { why },
-            }],
-            cycles: Vec::new(),
+        return Ok(Carrying {
+            set: carried_set,
+            sigs: Vec::new(),
+            not_comparable: Some(why),
             notes,
+            trials_with_logs,
             walks: walker.walks.into_inner(),
         });
     }
     let mut uncarried = 0usize;
     let carried_sigs: Vec<Option<CycleSignature>> = sigs
         .iter()
-        .zip(conditions)
+        .zip(&reference_index)
         .zip(nominal.iter())
         .zip(&like)
-        .map(|(((t, c), nom), &ok)| {
+        .map(|(((t, j), nom), &ok)| {
             let t = t.as_ref().filter(|_| ok)?;
-            let r = reference
-                .conditions
-                .iter()
-                .position(|rc| super::reference::same_condition(c, rc))
-                .and_then(|j| reference.sigs[j].as_ref());
+            let r = j.and_then(|j| reference.sigs[j].as_ref());
             let out = match (r, &nom.cycles) {
                 (Some(r), Some(n)) => super::reference::carry_cycles(t, r, n),
                 _ => None,
@@ -367,20 +386,6 @@ pub fn separate_through(
             out
         })
         .collect();
-    let through = SeparateOptions {
-        through_reference: true,
-        ..opts.clone()
-    };
-    let mut sep = separate_with(
-        &carried_set,
-        conditions,
-        &carried_sigs,
-        lib,
-        &through,
-        cache,
-        progress,
-    )?;
-    let mut notes = carried.notes;
     if !unlike.is_empty() {
         notes.push(format!(
             "{} trial(s) left out: the nominal model does not walk the reference's gait there \
@@ -392,7 +397,7 @@ pub fn separate_through(
             unlike.join("; ")
         ));
     }
-    if sigs.iter().any(Option::is_some) {
+    if trials_with_logs > 0 {
         notes.push(format!(
             "relative to the reference, each logged cycle is the nominal walk's + (trial − \
              reference), coefficient by coefficient, its sd the three means' and the change × \
@@ -407,9 +412,82 @@ pub fn separate_through(
             }
         ));
     }
+    Ok(Carrying {
+        set: carried_set,
+        sigs: carried_sigs,
+        not_comparable: None,
+        notes,
+        trials_with_logs,
+        walks: walker.walks.into_inner(),
+    })
+}
+
+/// [`separate_with`] on carried evidence: through a reference, with cycles, the summaries
+/// say which candidates are plausible and the cycles rank them (`Fitted::ranking`).
+fn separate_carried(
+    carrying: &Carrying,
+    conditions: &[Condition],
+    lib: &EffectLibrary,
+    opts: &SeparateOptions,
+    cache: &CycleCache,
+    progress: &dyn Observer,
+) -> Result<Separation, GapError> {
+    check(opts)?;
+    if let Some(why) = &carrying.not_comparable {
+        return Ok(Separation {
+            trials: carrying.set.trials.len(),
+            trials_with_logs: carrying.trials_with_logs,
+            relative_floor: opts.relative_floor,
+            alpha: opts.alpha,
+            rankings: vec![Ranking {
+                evidence: Evidence::Summaries,
+                fits: Vec::new(),
+                nominal_chi2: f64::NAN,
+                observations: 0,
+                overdispersion: 1.0,
+                best_p_value: f64::NAN,
+                verdict: Verdict::NotComparable { why: why.clone() },
+            }],
+            cycles: Vec::new(),
+            notes: carrying.notes.clone(),
+            walks: 0,
+        });
+    }
+    let through = SeparateOptions {
+        through_reference: true,
+        ..opts.clone()
+    };
+    let mut sep = separate_with(
+        &carrying.set,
+        conditions,
+        &carrying.sigs,
+        lib,
+        &through,
+        cache,
+        progress,
+    )?;
+    let mut notes = carrying.notes.clone();
     notes.append(&mut sep.notes);
     sep.notes = notes;
-    sep.walks += walker.walks.into_inner();
+    Ok(sep)
+}
+
+/// [`separate_with`] on what changed between `reference` and `set` ([`carry_through`]).
+#[allow(clippy::too_many_arguments)]
+pub fn separate_through(
+    set: &TrialSet,
+    conditions: &[Condition],
+    sigs: &[Option<CycleSignature>],
+    reference: &Reference<'_>,
+    lib: &EffectLibrary,
+    opts: &SeparateOptions,
+    cache: &CycleCache,
+    progress: &dyn Observer,
+) -> Result<Separation, GapError> {
+    check(opts)?;
+    let carrying = carry_through(set, conditions, sigs, reference, lib, opts, cache, progress)?;
+    let mut sep = separate_carried(&carrying, conditions, lib, opts, cache, progress)?;
+    sep.walks += carrying.walks;
     Ok(sep)
 }
 
@@ -423,10 +501,9 @@ pub fn separate_relative(
     progress: &dyn Observer,
 ) -> Result<Separation, GapError> {
     check(opts)?;
-    let conditions = resolve(set)?;
-    let sigs = measured_signatures(set, &conditions, opts.settle_cycles)?;
-    let reference_conditions = resolve(reference)?;
-    let reference_sigs = measured_signatures(reference, &reference_conditions, opts.settle_cycles)?;
+    let (conditions, sigs) = resolve_with_cycles(set, opts.settle_cycles)?;
+    let (reference_conditions, reference_sigs) =
+        resolve_with_cycles(reference, opts.settle_cycles)?;
     separate_through(
         set,
         &conditions,
@@ -1117,15 +1194,25 @@ pub fn follow_up_with(
             jobs.push((FollowPurpose::Confirm { knob: knob.clone() }, group));
         }
     }
+    // The carrying does not depend on the candidates: made once for every group.
+    let carrying = match (reference, jobs.is_empty()) {
+        (Some(r), false) => Some(carry_through(
+            set, conditions, sigs, r, lib, opts, cache, progress,
+        )?),
+        _ => None,
+    };
+    let mut carrying_walks = carrying.as_ref().map_or(0, |c| c.walks);
     for (purpose, group) in jobs {
         let o = SeparateOptions {
             candidates: group,
             ..opts.clone()
         };
-        let separation = match reference {
-            Some(r) => separate_through(set, conditions, sigs, r, lib, &o, cache, progress)?,
+        let mut separation = match &carrying {
+            Some(c) => separate_carried(c, conditions, lib, &o, cache, progress)?,
             None => separate_with(set, conditions, sigs, lib, &o, cache, progress)?,
         };
+        // The nominal walks made to carry count once, with the first separation.
+        separation.walks += std::mem::take(&mut carrying_walks);
         let verdict = final_verdict(&separation);
         match (&purpose, &verdict) {
             (FollowPurpose::Ambiguous | FollowPurpose::Explore, Verdict::Named { knob })
@@ -1173,53 +1260,33 @@ pub fn follow_up(
     opts: &SeparateOptions,
     progress: &dyn Observer,
 ) -> Result<FollowUp, GapError> {
-    if set.trials.iter().all(|t| t.trajectory.is_none()) {
-        return follow_up_with(
-            d,
-            set,
-            &[],
-            &[],
-            None,
-            lib,
-            opts,
-            &CycleCache::default(),
-            progress,
-        );
-    }
-    let conditions = resolve(set)?;
-    let sigs = measured_signatures(set, &conditions, opts.settle_cycles)?;
-    let cache = CycleCache::default();
-    match reference {
-        Some(r) => {
-            let rc = resolve(r)?;
-            let rs = measured_signatures(r, &rc, opts.settle_cycles)?;
-            let reference = Reference {
-                set: r,
-                conditions: &rc,
-                sigs: &rs,
-            };
-            follow_up_with(
-                d,
-                set,
-                &conditions,
-                &sigs,
-                Some(&reference),
-                lib,
-                opts,
-                &cache,
-                progress,
-            )
-        }
-        None => follow_up_with(
-            d,
-            set,
-            &conditions,
-            &sigs,
-            None,
-            lib,
-            opts,
-            &cache,
-            progress,
-        ),
-    }
+    // Without a log there is nothing to resolve or read: the answer's names stand.
+    let logged = set.trials.iter().any(|t| t.trajectory.is_some());
+    let (conditions, sigs) = if logged {
+        resolve_with_cycles(set, opts.settle_cycles)?
+    } else {
+        (Vec::new(), Vec::new())
+    };
+    let resolved_reference = match reference {
+        Some(r) if logged => Some((r, resolve_with_cycles(r, opts.settle_cycles)?)),
+        _ => None,
+    };
+    let reference = resolved_reference
+        .as_ref()
+        .map(|(r, (conditions, sigs))| Reference {
+            set: r,
+            conditions,
+            sigs,
+        });
+    follow_up_with(
+        d,
+        set,
+        &conditions,
+        &sigs,
+        reference.as_ref(),
+        lib,
+        opts,
+        &CycleCache::default(),
+        progress,
+    )
 }

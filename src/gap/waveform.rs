@@ -317,6 +317,24 @@ pub struct SignalCycle {
     pub cycle: Vec<f64>,
 }
 
+impl SignalCycle {
+    /// A signal's cycle from its mean coefficients and their spread: its RMS about its mean
+    /// and the cycle rebuilt at [`FIGURE_BINS`] phases follow from them.
+    pub fn from_coefficients(signal: Signal, coefficients: Vec<f64>, spread: Vec<f64>) -> Self {
+        let rms = (coefficients[1..].iter().map(|a| a * a).sum::<f64>() / 2.0).sqrt();
+        let cycle = (0..FIGURE_BINS)
+            .map(|b| evaluate(&coefficients, (b as f64 + 0.5) / FIGURE_BINS as f64))
+            .collect();
+        SignalCycle {
+            signal,
+            coefficients,
+            spread,
+            rms,
+            cycle,
+        }
+    }
+}
+
 /// The steady cycles of a log.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct CycleSignature {
@@ -403,23 +421,13 @@ pub fn signature(
                 (ss / (n - 1.0)).sqrt()
             })
             .collect();
-        let rms = (mean[1..].iter().map(|a| a * a).sum::<f64>() / 2.0).sqrt();
-        let cycle = (0..FIGURE_BINS)
-            .map(|b| evaluate(&mean, (b as f64 + 0.5) / FIGURE_BINS as f64))
-            .collect();
-        let mut coefficients = mean;
-        let mut spread = spread;
+        // The figure's cycle keeps the mean heading; the compared coefficients do not.
+        let mut cycle = SignalCycle::from_coefficients(signal, mean, spread);
         if signal.has_trend() {
-            coefficients[0] = f64::NAN;
-            spread[0] = f64::NAN;
+            cycle.coefficients[0] = f64::NAN;
+            cycle.spread[0] = f64::NAN;
         }
-        signals.push(SignalCycle {
-            signal,
-            coefficients,
-            spread,
-            rms,
-            cycle,
-        });
+        signals.push(cycle);
     }
     Ok(CycleSignature {
         drive_frequency_hz,
