@@ -85,6 +85,8 @@ for name in lagged lagged-next lagged-heldout; do drake_reference "$name"; done
 drake_reference lagged-logs 5
 # The same rules on Drake trials with logs made after them (other magnitudes; twentieth session).
 drake_reference lagged-logs-heldout 5
+# And on Drake trials made after the one-metric rule (twenty-second session).
+drake_reference lagged-logs-heldout2 5
 # Drake-SAP's trials against mugatu-ref-sap (the convex friction cone), plain and through the
 # no-effect trials: with the signed velocity (eighteenth session) and compared on speed
 # (criteria.walking_direction = "either"; nineteenth session, four of the nine files).

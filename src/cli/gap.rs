@@ -431,8 +431,10 @@ pub struct SeparateArgs {
     /// same condition; a log is compared only where its reference trial has one too. A trial
     /// is used only where the nominal model walks the reference's gait (step frequency within
     /// 5 %, speed, roll and pitch within 25 %, each plus 2 sd); where it walks none, the
-    /// answer is "not comparable". With logs, the carried summaries say which candidates are
-    /// plausible and the cycles tell those apart.
+    /// answer is "not comparable". On the summaries, a rival that fits within noise, or would
+    /// with one metric left out, is not told apart (the model's version of an effect may
+    /// answer one metric unlike the robot's). With logs, the carried summaries say which
+    /// candidates are plausible (by the same test) and the cycles tell those apart.
     #[arg(long, value_name = "FILE")]
     pub reference: Option<PathBuf>,
 }

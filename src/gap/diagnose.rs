@@ -564,11 +564,6 @@ pub fn build_curves(
             curves[j].insert(x, &s);
         }
     }
-    if std::env::var("GAP_DEBUG").is_ok() {
-        for (&k, c) in which.iter().zip(&curves) {
-            eprintln!("{}: {} nodes", knobs.list[k].label(), c.x.len());
-        }
-    }
     Ok(curves)
 }
 

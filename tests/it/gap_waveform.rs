@@ -535,19 +535,22 @@ fn diagnose_through_drakes_no_effect_trials_names_nothing_for_a_cause_outside_th
 /// them): Drake's hip Coulomb friction at 0.08 N·m, beyond the magnitudes the rules were fixed
 /// on. There Drake's friction changes the summaries unlike ours, and carried through the
 /// no-effect trials they favour its look-alike, viscous damping (χ² 12.8 against 60.8 on 63
-/// values); the cycles change as ours do, and summaries and cycles together name Coulomb
-/// friction at Drake's value within 10 %.
+/// values, 43 of it on the yaw swing). Through a reference a rival that fits within noise
+/// (or would but for one metric) is not told apart on the summaries, so they answer "cannot
+/// tell" — before that rule they named viscous damping, here and in 5 of 5 noisy draws. The
+/// cycles change as ours do, and summaries and cycles together name Coulomb friction at
+/// Drake's value within 10 %.
 #[test]
-fn held_out_the_cycles_name_drakes_large_hip_friction_the_summaries_call_damping() {
+fn held_out_drakes_large_hip_friction_is_not_called_damping_and_the_cycles_name_it() {
     let r = separate_drake_in(
         "gap-lagged-logs-heldout",
         "trials-hip_coulomb_friction-0.08.csv",
         "hip_viscous_damping,hip_coulomb_friction",
     );
     assert_eq!(r[0]["evidence"], "summaries");
-    assert_ne!(
-        r[0]["verdict"]["knob"], "hip_coulomb_friction",
-        "the summaries alone were expected to favour the look-alike: {}",
+    assert_eq!(
+        r[0]["verdict"]["kind"], "cannot_tell",
+        "the summaries alone cannot tell the look-alikes apart here: {}",
         r[0]["verdict"]
     );
     assert_eq!(r[1]["evidence"], "summaries_and_waveforms");
@@ -555,6 +558,30 @@ fn held_out_the_cycles_name_drakes_large_hip_friction_the_summaries_call_damping
     assert_eq!(r[1]["verdict"]["knob"], "hip_coulomb_friction");
     let v = r[1]["fits"][0]["value"].as_f64().expect("value");
     assert!((0.072..=0.088).contains(&v), "fitted {v} N·m, Drake's 0.08");
+}
+
+/// Held out from the one-metric rule (`tests/golden/drake/gap-lagged-logs-heldout2/`, made
+/// after it): Drake's hip Coulomb friction at 0.12 N·m, beyond every magnitude seen. Carried
+/// through Drake's no-effect trials the summaries favour viscous damping (χ² 28.9 against 133
+/// on 63 values); they must not name it (a rival within noise but for one metric is not told
+/// apart), and the cycles name Coulomb friction at Drake's value within 10 %.
+#[test]
+fn held_out_again_drakes_largest_hip_friction_is_not_called_damping() {
+    let r = separate_drake_in(
+        "gap-lagged-logs-heldout2",
+        "trials-hip_coulomb_friction-0.12.csv",
+        "hip_viscous_damping,hip_coulomb_friction",
+    );
+    assert_eq!(r[0]["evidence"], "summaries");
+    assert_eq!(
+        r[0]["verdict"]["kind"], "cannot_tell",
+        "{}",
+        r[0]["verdict"]
+    );
+    assert_eq!(r[1]["verdict"]["kind"], "named", "{}", r[1]["verdict"]);
+    assert_eq!(r[1]["verdict"]["knob"], "hip_coulomb_friction");
+    let v = r[1]["fits"][0]["value"].as_f64().expect("value");
+    assert!((0.108..=0.132).contains(&v), "fitted {v} N·m, Drake's 0.12");
 }
 
 /// Outside what a single-knob rule assumes: Drake added both hip losses at once (viscous
