@@ -1736,7 +1736,7 @@ fn parameter_scores(rows: &[CaseRow], scores: &mut Vec<Score>) {
 /// another named — on the answers, and again on the names that stand after the logged
 /// cycles where the trials have logs.
 fn drake_scores(rows: &[CaseRow], aliases: &BTreeMap<String, String>, scores: &mut Vec<Score>) {
-    let drake: Vec<CaseRow> = rows.iter().filter(|r| r.kind == "drake").cloned().collect();
+    let drake: Vec<&CaseRow> = rows.iter().filter(|r| r.kind == "drake").collect();
     if drake.is_empty() {
         return;
     }
@@ -1756,13 +1756,13 @@ fn drake_scores(rows: &[CaseRow], aliases: &BTreeMap<String, String>, scores: &m
     let logged: Vec<CaseRow> = drake
         .iter()
         .filter(|r| r.logged_trials > 0)
-        .map(with_cycles)
+        .map(|r| with_cycles(r))
         .collect();
     if logged.is_empty() {
         return;
     }
     drake_rates(
-        &logged,
+        &logged.iter().collect::<Vec<_>>(),
         [
             "Drake with logged cycles, no effect added: anything named (the answer with the cycles)",
             "Drake with logged cycles, effect added: that effect named (the answer with the cycles)",
@@ -1778,7 +1778,7 @@ fn drake_scores(rows: &[CaseRow], aliases: &BTreeMap<String, String>, scores: &m
 /// The three Drake rates of `rows` under `labels`: a null case blamed (`blamed`), the added
 /// effect named, another named (`other`).
 fn drake_rates(
-    rows: &[CaseRow],
+    rows: &[&CaseRow],
     labels: [&str; 3],
     blamed: &dyn Fn(&CaseRow) -> bool,
     other: &dyn Fn(&CaseRow) -> bool,

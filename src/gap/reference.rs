@@ -23,11 +23,10 @@
 use super::error::GapError;
 use super::fit::{Fit, FitContext};
 use super::problem::Observation;
-use super::select::{Step, within_noise};
+use super::select::{Step, fit_p_value, within_noise};
 use super::simulate::{Condition, SimMetrics};
 use super::trials::{Measurement, Metric, Trial, TrialSet};
 use super::waveform::{CycleSignature, SignalCycle};
-use crate::regression::dist::chi2_upper_p;
 
 /// The carried trials and what the carrying did, in words.
 #[derive(Clone, Debug)]
@@ -342,13 +341,7 @@ pub fn within_noise_but_one(
 ) -> Option<WithinNoiseButOne> {
     let z2 = |o: &Observation| o.z2(simulated(o));
     let total: f64 = obs.iter().map(z2).sum();
-    let p_of = |chi2: f64, n: usize| {
-        let dof = n.saturating_sub(k);
-        if dof == 0 {
-            return 0.0;
-        }
-        chi2_upper_p(chi2, dof as f64).unwrap_or(0.0)
-    };
+    let p_of = |chi2: f64, n: usize| fit_p_value(chi2, n, k);
     if p_of(total, obs.len()) >= alpha {
         return None;
     }
@@ -620,40 +613,41 @@ mod tests {
         assert_eq!(like_gait(&bare, &rocking, 0.0), Ok(()));
     }
 
-    /// Observations of sd 1, each simulated at its value + `z`: `(trial, metric, z)`.
-    fn residuals(rows: &[(usize, Metric, f64)]) -> (Vec<Observation>, Vec<f64>) {
-        let obs = rows
-            .iter()
-            .map(|&(trial, metric, _)| Observation {
+    /// Observations of sd 1 whose model value is 10, each measured `z` sd below it:
+    /// `(trial, metric, z)`.
+    fn residuals(rows: &[(usize, Metric, f64)]) -> Vec<Observation> {
+        rows.iter()
+            .map(|&(trial, metric, z)| Observation {
                 trial,
                 metric,
-                value: 10.0,
+                value: 10.0 - z,
                 sd: 1.0,
                 sd_assumed: false,
             })
-            .collect();
-        (obs, rows.iter().map(|r| 10.0 + r.2).collect())
+            .collect()
     }
 
     /// Hand-derived: 3 trials × 3 metrics, all within noise but the yaw swing, 4 sd off in
     /// every trial (χ² 48 of 48.75 on 9 values: p ≈ 10⁻⁷ on 8 dof). Left out, 0.75 remains on
-    /// 6 values (5 dof, p = 0.98): within noise but one metric, the yaw swing. Spread over two
+    /// 6 values (5 dof: p = 0.98011, from the closed form for odd dof, 2(1 − Φ(√x)) +
+    /// 2φ(√x)(√x + x^{3/2}/3)): within noise but one metric, the yaw swing. Spread over two
     /// metrics instead (z = 4 on the yaw swing of trial 0 and on the speed of trials 1 and 2),
     /// leaving out either leaves χ² ≥ 16 on 6 values (p ≤ 0.007 on 5 dof): not within noise.
     #[test]
     fn a_rival_rejected_by_one_metric_alone_is_within_noise_but_that_metric() {
+        let model = |_: &Observation| 10.0;
         let mut rows = Vec::new();
         for t in 0..3 {
             rows.push((t, Metric::VelocityMps, 0.5));
             rows.push((t, Metric::PeakTorqueNm, 0.0));
             rows.push((t, Metric::YawPpDeg, 4.0));
         }
-        let (obs, sim) = residuals(&rows);
-        let at = |o: &Observation| sim[obs.iter().position(|p| std::ptr::eq(p, o)).unwrap()];
-        let b = within_noise_but_one(&obs, at, 1, 0.01).expect("within noise but the yaw swing");
+        let b = within_noise_but_one(&residuals(&rows), model, 1, 0.01)
+            .expect("within noise but the yaw swing");
         assert_eq!(b.metric, Metric::YawPpDeg);
         assert!((b.chi2_metric - 48.0).abs() < 1e-9 && (b.chi2_left - 0.75).abs() < 1e-9);
         assert_eq!(b.n_left, 6);
+        assert!((b.p_left - 0.98011).abs() < 1e-4, "p {}", b.p_left);
 
         let mut spread = rows.clone();
         spread[2].2 = 4.0; // trial 0's yaw
@@ -661,15 +655,17 @@ mod tests {
         spread[8].2 = 0.0;
         spread[3].2 = 4.0; // trial 1's speed
         spread[6].2 = 4.0; // trial 2's speed
-        let (obs, sim) = residuals(&spread);
-        let at = |o: &Observation| sim[obs.iter().position(|p| std::ptr::eq(p, o)).unwrap()];
-        assert_eq!(within_noise_but_one(&obs, at, 1, 0.01), None);
+        assert_eq!(
+            within_noise_but_one(&residuals(&spread), model, 1, 0.01),
+            None
+        );
 
         // Within noise with nothing left out: not this rule's case.
         let fine: Vec<_> = rows.iter().map(|&(t, m, _)| (t, m, 0.5)).collect();
-        let (obs, sim) = residuals(&fine);
-        let at = |o: &Observation| sim[obs.iter().position(|p| std::ptr::eq(p, o)).unwrap()];
-        assert_eq!(within_noise_but_one(&obs, at, 1, 0.01), None);
+        assert_eq!(
+            within_noise_but_one(&residuals(&fine), model, 1, 0.01),
+            None
+        );
     }
 
     /// The null: trials that are their reference carry exactly onto the nominal walk.

@@ -269,10 +269,19 @@ pub fn gap_of(fit: &Fit, n: usize) -> f64 {
     (fit.held_out.unwrap_or(fit.chi2_data) / n.max(1) as f64).sqrt()
 }
 
+/// The goodness-of-fit p-value of a χ² on `n` values of a model with `k` free knobs (n − k
+/// dof); 0 when no dof is left.
+pub fn fit_p_value(chi2: f64, n: usize, k: usize) -> f64 {
+    let dof = n.saturating_sub(k);
+    if dof == 0 {
+        return 0.0;
+    }
+    chi2_upper_p(chi2, dof as f64).unwrap_or(0.0)
+}
+
 /// The data χ² is within noise at level α (n − k dof).
 pub fn within_noise(fit: &Fit, n: usize, alpha: f64) -> bool {
-    let dof = n.saturating_sub(fit.k());
-    dof > 0 && chi2_upper_p(fit.chi2_data, dof as f64).unwrap_or(0.0) >= alpha
+    fit_p_value(fit.chi2_data, n, fit.k()) >= alpha
 }
 
 /// χ² difference below which two candidates of one step are not separable: the
@@ -944,8 +953,7 @@ impl Selector<'_, '_> {
         let Some(chi2) = self.ctx.at_resolution(current)?.1 else {
             return Ok(false);
         };
-        let dof = self.n.saturating_sub(current.k());
-        Ok(dof > 0 && chi2_upper_p(chi2, dof as f64).unwrap_or(0.0) >= self.opts.alpha)
+        Ok(fit_p_value(chi2, self.n, current.k()) >= self.opts.alpha)
     }
 
     /// Forward steps from `current` until nothing passes or the step limit.

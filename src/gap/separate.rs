@@ -810,7 +810,36 @@ impl Fitted<'_> {
         let (nom_s, nom_w) = self.nominal;
         let n = obs.len() + if mi == 1 { self.n_wave } else { 0 };
         let cost = |s: f64, w: f64| if mi == 1 { s + w } else { s };
-        let mut list: Vec<CandidateFit> = self
+        let dof = |n: usize| (n.max(2) - 1) as f64;
+        let nb = if mi == 1 { 2.0 } else { 1.0 };
+        // Through a reference, with cycles: which look-alike carried summaries favour is
+        // the engines' business (the carried numbers hold an error no sd counts; measured on
+        // Drake-Lagged's hip Coulomb friction 0.05 N·m, noise-free: the summaries favour
+        // viscous damping by Δχ² 18.6), while a hip loss changes the robot's cycle as it
+        // changes the model's (r ≥ 0.994). So the summaries say which candidates are
+        // plausible (within noise there), the cycles rank those, and a plausible rival is
+        // told apart only by the cycles.
+        let cycles_decide = mi == 1 && opts.through_reference && self.n_wave > 0;
+        // The summaries' p-value (Bonferroni over the blocks); through a reference the larger
+        // of it and the p-value without the one metric that misses most: a candidate only one
+        // metric rejects is plausible, since that metric's misfit may be the engines' versions
+        // of the effect answering it apart (`reference::within_noise_but_one_metric`,
+        // measured on Drake's hip Coulomb friction 0.08 N·m: the yaw swing).
+        let summaries_p = |b: &Best| {
+            let p = (nb * chi2_upper_p(b.s, dof(obs.len())).unwrap_or(0.0)).min(1.0);
+            if !opts.through_reference {
+                return p;
+            }
+            super::reference::within_noise_but_one(
+                obs,
+                |o| b.sims[o.trial].metrics.get(o.metric),
+                1,
+                opts.alpha / nb,
+            )
+            .map_or(p, |w| p.max((nb * w.p_left).min(1.0)))
+        };
+        // Each candidate with its summaries' p-value, computed once.
+        let mut ranked: Vec<(CandidateFit, f64)> = self
             .idx
             .iter()
             .zip(self.fits)
@@ -818,7 +847,7 @@ impl Fitted<'_> {
                 let knob = &self.knobs.list[k];
                 let b = &f[mi];
                 let span = knob.hi - knob.lo;
-                CandidateFit {
+                let fit = CandidateFit {
                     knob: knob.label(),
                     kind: knob.kind,
                     value: knob.si(b.x),
@@ -830,51 +859,26 @@ impl Fitted<'_> {
                     chi2: cost(b.s, b.w),
                     delta: 0.0,
                     separated: false,
-                }
+                };
+                (fit, summaries_p(b))
             })
             .collect();
-        let dof = |n: usize| (n.max(2) - 1) as f64;
-        let nb = if mi == 1 { 2.0 } else { 1.0 };
-        // Through a reference, with cycles: which look-alike carried summaries favour is
-        // the engines' business (the carried numbers hold an error no sd counts; measured on
-        // Drake-Lagged's hip Coulomb friction 0.05 N·m, noise-free: the summaries favour
-        // viscous damping by Δχ² 18.6), while a hip loss changes the robot's cycle as it
-        // changes the model's (r ≥ 0.994). So the summaries say which candidates are
-        // plausible (within noise there), the cycles rank those, and a plausible rival is
-        // told apart only by the cycles.
-        let cycles_decide = mi == 1 && opts.through_reference && self.n_wave > 0;
-        // Through a reference, a candidate that only one metric rejects is plausible: that
-        // metric's misfit may be the engines' versions of the effect answering it apart
-        // (`reference::within_noise_but_one_metric`, measured on Drake's hip Coulomb
-        // friction 0.08 N·m: the yaw swing).
-        // The summaries' p-value (Bonferroni over the blocks), through a reference the
-        // larger of it and the p-value without the one metric that misses most.
-        let summaries_p = |f: &CandidateFit| {
-            let p = (nb * chi2_upper_p(f.chi2_summaries, dof(obs.len())).unwrap_or(0.0)).min(1.0);
-            if !opts.through_reference {
-                return p;
-            }
-            let b = &self.fits[self.position(&f.knob)][mi];
-            super::reference::within_noise_but_one(
-                obs,
-                |o| b.sims[o.trial].metrics.get(o.metric),
-                1,
-                opts.alpha / nb,
-            )
-            .map_or(p, |w| p.max((nb * w.p_left).min(1.0)))
-        };
-        let plausible = |f: &CandidateFit| summaries_p(f) >= opts.alpha;
+        let is_plausible = |p: f64| p >= opts.alpha;
         if cycles_decide {
-            list.sort_by(|a, b| {
-                plausible(b).cmp(&plausible(a)).then(if plausible(a) {
-                    a.chi2_waveforms.total_cmp(&b.chi2_waveforms)
-                } else {
-                    a.chi2.total_cmp(&b.chi2)
-                })
+            ranked.sort_by(|(a, pa), (b, pb)| {
+                is_plausible(*pb)
+                    .cmp(&is_plausible(*pa))
+                    .then(if is_plausible(*pa) {
+                        a.chi2_waveforms.total_cmp(&b.chi2_waveforms)
+                    } else {
+                        a.chi2.total_cmp(&b.chi2)
+                    })
             });
         } else {
-            list.sort_by(|a, b| a.chi2.total_cmp(&b.chi2));
+            ranked.sort_by(|(a, _), (b, _)| a.chi2.total_cmp(&b.chi2));
         }
+        let (mut list, summary_ps): (Vec<CandidateFit>, Vec<f64>) = ranked.into_iter().unzip();
+        let plausible = |i: usize| is_plausible(summary_ps[i]);
         let best = list[0].chi2;
         // Each block of evidence (summaries; cycles) is tested on its own: pooled, a few
         // hundred well-fitting cycle coefficients would dilute a summary gap into "no gap"
@@ -893,10 +897,10 @@ impl Fitted<'_> {
             .map(|(n, c, _)| c / dof(*n))
             .fold(1.0f64, f64::max);
         let per_test = opts.alpha / (list.len() - 1) as f64;
-        let (best_plausible, best_w) = (plausible(&list[0]), list[0].chi2_waveforms);
-        for f in list.iter_mut().skip(1) {
+        let (best_plausible, best_w) = (plausible(0), list[0].chi2_waveforms);
+        for (i, f) in list.iter_mut().enumerate().skip(1) {
             if cycles_decide && best_plausible {
-                if plausible(f) {
+                if plausible(i) {
                     f.delta = (f.chi2_waveforms - best_w) / phi;
                     f.separated = chi2_upper_p(f.delta, 1.0).unwrap_or(1.0) < per_test;
                 } else {
@@ -915,7 +919,7 @@ impl Fitted<'_> {
             // (or would but for one metric) is not told apart, as in `gap diagnose
             // --reference` (`reference::rivals_within_noise`).
             f.separated = chi2_upper_p(f.delta, 1.0).unwrap_or(1.0) < per_test
-                && !(mi == 0 && opts.through_reference && best_plausible && plausible(f));
+                && !(mi == 0 && opts.through_reference && best_plausible && plausible(i));
         }
         let nominal_chi2 = cost(nom_s, nom_w);
         let block_p = |c: f64, n: usize| (nb * chi2_upper_p(c, dof(n)).unwrap_or(0.0)).min(1.0);
@@ -925,7 +929,7 @@ impl Fitted<'_> {
             .enumerate()
             .map(|(i, (n, c, _))| {
                 if i == 0 && cycles_decide {
-                    summaries_p(&list[0])
+                    summary_ps[0]
                 } else {
                     block_p(*c, *n)
                 }

@@ -321,7 +321,8 @@ impl SignalCycle {
     /// A signal's cycle from its mean coefficients and their spread: its RMS about its mean
     /// and the cycle rebuilt at [`FIGURE_BINS`] phases follow from them.
     pub fn from_coefficients(signal: Signal, coefficients: Vec<f64>, spread: Vec<f64>) -> Self {
-        let rms = (coefficients[1..].iter().map(|a| a * a).sum::<f64>() / 2.0).sqrt();
+        // Skip, not slice: an empty coefficient list has an RMS of 0, not a panic.
+        let rms = (coefficients.iter().skip(1).map(|a| a * a).sum::<f64>() / 2.0).sqrt();
         let cycle = (0..FIGURE_BINS)
             .map(|b| evaluate(&coefficients, (b as f64 + 0.5) / FIGURE_BINS as f64))
             .collect();

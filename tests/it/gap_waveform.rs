@@ -447,14 +447,19 @@ fn the_cycles_through_drakes_no_effect_trials_name_the_damping_drake_added() {
     assert!((0.0054..=0.0066).contains(&v), "fitted {v}, Drake's 0.006");
 }
 
-/// Outside what the rule assumes: Drake lowered the foot–floor μ from 0.8 to 0.4, a cause
-/// that is neither candidate. Through the reference, neither hip loss may be named, on the
-/// summaries or with the cycles.
+/// Outside what the rule assumes: Drake lowered the foot–floor μ from 0.8 to 0.4, or made
+/// the floor soft, a cause that is neither candidate. Through the reference, neither hip loss
+/// may be named, on the summaries or with the cycles. The 30 MPa floor is where the
+/// one-metric rule's leniency bites: both hip losses miss the carried summaries mostly in the
+/// yaw swing (χ² 127 on 63 values), so both are plausible but for it, and the cycles cannot
+/// tell them apart; the answer is "cannot tell" between two wrong candidates (before the rule:
+/// "none fits"), never a name.
 #[test]
 fn the_cycles_through_drakes_no_effect_trials_name_no_hip_loss_for_a_floor_change() {
     for file in [
         "trials-friction_coefficient-0.4.csv",
         "trials-soft_ground-6e6.csv",
+        "trials-soft_ground-3e7.csv",
     ] {
         let r = separate_drake_through_none(file, "hip_viscous_damping,hip_coulomb_friction");
         for ranking in &r {
