@@ -242,7 +242,12 @@ pub struct SelectionArgs {
     /// larger one is walked, and one that fits within noise and whose knobs form a chain
     /// every rule accepts replaces the answer (then weighed again). For a look-alike that
     /// forward selection took first (actuation latency for hip backlash) and that kept the
-    /// true pair out of reach.
+    /// true pair out of reach. When no such model fits, the larger model itself may replace
+    /// an answer beyond noise, and so may a pair from the nominal in place of an answer of
+    /// one knob (the joint step's search): each only if it fits within noise, passes the
+    /// chain's or the joint step's rules, and is then weighed against every model of its
+    /// size (an unreported slope with hip Coulomb friction or damping, where the leg's COM
+    /// offset alone explains more and was taken first).
     #[arg(long, conflicts_with = "within_noise_subset")]
     pub no_within_noise_subset: bool,
     /// With --plain-selection: the within-noise subset (on by default; it acts only after
@@ -676,7 +681,11 @@ fn synth(a: &SynthArgs) -> anyhow::Result<ExitCode> {
         command.push_str(" --expected");
     }
     let conditions = match &a.conditions {
-        Some(p) => Some(TrialSet::read(p)?),
+        Some(p) => {
+            // The conditions (and their designs) are the file's: the source must say so.
+            command.push_str(&format!(" --conditions {}", p.display()));
+            Some(TrialSet::read(p)?)
+        }
         None => None,
     };
     let n = conditions.as_ref().map(|c| c.trials.len()).unwrap_or(12) as u64;

@@ -27,7 +27,9 @@
 //! recalibration test deferred to the end (`Selector::settle_deferred`), the step's
 //! look-alikes compared again in the final model (`Selector::rivals_at_end`) and, where the
 //! look-ahead unnamed a knob, the within-noise subset of its larger model
-//! (`Selector::within_noise_subset`). `SelectOptions::plain` is the selection without them.
+//! (`Selector::within_noise_subset`; failing that, the larger model itself or a pair from
+//! the nominal that fits within noise, `Selector::within_noise_larger` and
+//! `Selector::within_noise_pair`). `SelectOptions::plain` is the selection without them.
 //! The joint step (`Selector::joint`: pairs of knobs fitted together when no single knob
 //! passes), Levenberg–Marquardt on walks and the end search for look-alikes are
 //! experimental, off by default.
@@ -134,6 +136,15 @@ pub struct SelectOptions {
     /// pair; the look-ahead sees the pair inside a larger model but only takes names away.
     /// On by default since the fourteenth session (reports/gap-benchmark.md): measured on
     /// every benchmark case the look-ahead could have acted on.
+    ///
+    /// Since 2026-12-03 the same switch holds two more models that can replace an answer
+    /// beyond noise, both for a greedy first step that took a stand-in for two causes that
+    /// each alone explain little: the look-ahead's larger model itself when no model of the
+    /// answer's size inside it fits (`Selector::within_noise_larger`), and, for an answer of
+    /// one knob, a pair from the nominal found by the joint step's search
+    /// (`Selector::within_noise_pair`). Each must fit within noise and pass the chain's or
+    /// the joint step's rules; the model taken is then weighed against every model of its
+    /// size (`look_alikes_at_end`) and one size up (`look_ahead`).
     #[serde(skip_serializing_if = "is_false")]
     pub within_noise_subset: bool,
     /// Forward selection stops where the model is within noise once the simulator's
@@ -371,13 +382,38 @@ pub fn select(
             && !larger.is_empty()
             && !within_noise(&current, sel.n, opts.alpha)
             && !sel.stops_at_resolution(&current)?
-            && let Some((chain, fit)) = sel.within_noise_subset(&larger, &current)?
         {
-            steps = chain;
-            current = fit;
-            if opts.rivals_at_end {
-                sel.rivals_at_end(&current, &mut steps)?;
+            if let Some((chain, fit)) = sel.within_noise_subset(&larger, &current)? {
+                steps = chain;
+                current = fit;
+                if opts.rivals_at_end {
+                    sel.rivals_at_end(&current, &mut steps)?;
+                }
+                sel.look_ahead(&current, &mut steps)?;
+            } else if let Some((chain, fit)) = sel.within_noise_larger(&larger, &current)? {
+                // Never weighed against the models of its own size: every knob's look-alikes
+                // are searched in it (not only the ones a step flagged), then one size up.
+                steps = chain;
+                current = fit;
+                sel.look_alikes_at_end(&current, &mut steps)?;
+                sel.look_ahead(&current, &mut steps)?;
             }
+        }
+        // One knob: a stand-in a greedy first step took. With none, no single knob passed
+        // and this would be the joint step, which is off (it named a look-alike).
+        if opts.within_noise_subset
+            && current.active.len() == 1
+            && opts.max_steps >= 2
+            && !within_noise(&current, sel.n, opts.alpha)
+            && !sel.stops_at_resolution(&current)?
+            && let Some(taken) = sel.within_noise_pair(&current)?
+        {
+            steps = taken.steps;
+            current = taken.fit;
+            if let Some(nb) = taken.baseline {
+                sel.baseline = Some(nb);
+            }
+            sel.look_alikes_at_end(&current, &mut steps)?;
             sel.look_ahead(&current, &mut steps)?;
         }
     }
@@ -987,7 +1023,8 @@ impl Selector<'_, '_> {
                     if self.opts.joint_step
                         && steps.len() + 2 <= self.opts.max_steps
                         && !within_noise(current, self.n, self.opts.alpha)
-                        && let Some(mut taken) = self.joint(current)?
+                        && let Some(mut taken) =
+                            self.joint(current, "no single knob passed", None)?
                     {
                         if let Some(last) = taken.steps.last_mut() {
                             last.candidates = rows;
@@ -1195,7 +1232,15 @@ impl Selector<'_, '_> {
     /// Returns the two steps (the knob that explains more alone first, its gap the walked
     /// model with it alone), the model and the new effect baseline; None, with a note of
     /// why the best pair failed, when none passes.
-    fn joint(&mut self, current: &Fit) -> Result<Option<JointTaken>, GapError> {
+    ///
+    /// With `reach`, only pairs the surrogate puts within that χ² per degree of freedom are
+    /// walked (a pair that must fit within noise: `within_noise_pair`).
+    fn joint(
+        &mut self,
+        current: &Fit,
+        context: &str,
+        reach: Option<f64>,
+    ) -> Result<Option<JointTaken>, GapError> {
         let ctx = self.ctx;
         let knobs = &ctx.knobs.list;
         let n = self.n;
@@ -1229,6 +1274,7 @@ impl Selector<'_, '_> {
                 (pair, ctx.screen(&set, &starts, current))
             })
             .filter(|(_, f)| p_pair(f) < alpha_pair)
+            .filter(|(_, f)| reach.is_none_or(|r| dispersion(f.chi2_data, n, f.k()) <= r))
             .collect();
         screened.sort_by(|a, b| a.1.chi2.total_cmp(&b.1.chi2));
         let mut walked: Vec<((usize, usize), Fit)> = Vec::new();
@@ -1270,9 +1316,8 @@ impl Selector<'_, '_> {
             }
         }
         if let Some(first) = first_why {
-            self.notes.push(format!(
-                "joint step (no single knob passed): {first}; not called"
-            ));
+            self.notes
+                .push(format!("joint step ({context}): {first}; not called"));
         }
         Ok(None)
     }
@@ -2071,6 +2116,161 @@ impl Selector<'_, '_> {
             return Ok(Some((chain, fit)));
         }
         Ok(None)
+    }
+
+    /// When no model of the answer's size inside them fits within noise: the look-ahead's
+    /// larger model itself, when it fits within noise, inside its ranges, and its knobs form
+    /// a chain every forward rule accepts (rebuilt from the nominal). Forward selection is
+    /// greedy: where two causes act together and neither alone is the best first step (an
+    /// unreported slope with hip Coulomb friction, each alone 8–16 % of the gap), a third
+    /// knob that alone explains more is taken first and the true pair, which fits within
+    /// noise, stays out of reach. The caller weighs the model taken against every model of
+    /// its size (`look_alikes_at_end`) and one size up (`look_ahead`): both only take
+    /// names away.
+    fn within_noise_larger(
+        &mut self,
+        larger: &[(Vec<usize>, Fit)],
+        current: &Fit,
+    ) -> Result<Option<(Vec<Step>, Fit)>, GapError> {
+        let ctx = self.ctx;
+        let mut fits: Vec<&(Vec<usize>, Fit)> = larger
+            .iter()
+            .filter(|(_, f)| within_noise(f, self.n, self.opts.alpha) && inside_ranges(f))
+            .collect();
+        fits.sort_by(|a, b| a.1.chi2.total_cmp(&b.1.chi2));
+        for (set, f) in fits {
+            let (mut chain, built) = match self.rebuild_chain(set)? {
+                Ok(built) => built,
+                Err(why) => match self.larger_as_pair(set, f)? {
+                    Ok(taken) => taken,
+                    Err(why_pair) => {
+                        self.notes.push(format!(
+                            "{} fits these trials within noise (χ² {:.1}) but its knobs do not \
+                             form a chain every rule accepts ({why}){why_pair}: not taken",
+                            self.label_set(set),
+                            f.chi2
+                        ));
+                        continue;
+                    }
+                },
+            };
+            let fit = if f.chi2 < built.chi2 && f.held_out.is_some() {
+                f.clone()
+            } else {
+                ctx.with_held_out(if f.chi2 < built.chi2 {
+                    f.clone()
+                } else {
+                    built
+                })
+            };
+            self.notes.push(format!(
+                "{} fits these trials within noise (χ² {:.1}), {} does not (χ² {:.1}), and no \
+                 model of that size inside it does; its knobs form a chain every rule accepts, or \
+                 pass the joint step's rules together (forward selection took a knob that \
+                 alone explains more): it replaced the \
+                 answer, and its knobs were weighed against every model of their size; the \
+                 chain below is rebuilt from the nominal",
+                self.label_set(set),
+                fit.chi2,
+                self.label_set(&current.active),
+                current.chi2
+            ));
+            self.end_chain_at(&mut chain, &fit);
+            return Ok(Some((chain, fit)));
+        }
+        Ok(None)
+    }
+
+    /// A pair of knobs from the nominal in place of an answer of one knob that leaves the
+    /// trials beyond noise: the joint step's search (`joint`: every pair screened
+    /// on the surrogate, the best walked, judged by `judge_pair`), taken only when the pair
+    /// fits within noise, beats the answer by the identification distance and held out, and
+    /// does not keep the answer's knob.
+    /// Forward selection is greedy: two causes that each alone explain little (an unreported
+    /// slope with hip viscous damping, neither significant alone) leave a third knob that
+    /// alone explains more to be taken first, and the look-ahead, which exchanges only
+    /// knobs significant alone, never sees the pair. The joint step at every step is off
+    /// (it named a look-alike on a noise draw); here the pair must explain the whole gap,
+    /// and the caller weighs it against every model of its size and one size up.
+    fn within_noise_pair(&mut self, current: &Fit) -> Result<Option<JointTaken>, GapError> {
+        if !self.nominal.active.is_empty() {
+            return Ok(None);
+        }
+        let nominal = self.nominal.clone();
+        // Far beyond noise on the surrogate (another engine's trials), no pair is walked.
+        let reach = Some(SUBSET_REACH_CHI2_PER_DOF);
+        let Some(taken) =
+            self.joint(&nominal, "the answer leaves the trials beyond noise", reach)?
+        else {
+            return Ok(None);
+        };
+        let n = self.n;
+        let margin = self.identification_distance(current);
+        let pair = self.label_set(&taken.fit.active);
+        let why_not = if taken.fit.active.iter().any(|k| current.active.contains(k)) {
+            // A second knob beside the answer's is forward selection's to add, and it did
+            // not: its rules, not this one, judge a pair that keeps the answer.
+            Some("it keeps the answer's knob".to_string())
+        } else if !within_noise(&taken.fit, n, self.opts.alpha) {
+            Some("it does not fit within noise either".to_string())
+        } else if taken.fit.chi2 >= current.chi2 - margin {
+            Some(format!(
+                "it does not beat the answer by the identification distance ({margin:.1})"
+            ))
+        } else {
+            let own = self.ctx.with_held_out(current.clone());
+            (!held_out_better(&taken.fit, &own)).then(|| "not better held out".to_string())
+        };
+        if let Some(why) = why_not {
+            self.notes.push(format!(
+                "{pair} passes the joint step's rules from the nominal (χ² {:.1}) but {why}: \
+                 not taken",
+                taken.fit.chi2
+            ));
+            return Ok(None);
+        }
+        self.notes.push(format!(
+            "{pair} fits these trials within noise (χ² {:.1}) where the answer {} did not \
+             (χ² {:.1}), and passes the joint step's rules from the nominal (forward selection \
+             took a knob that alone explains more): it replaced the answer, and its knobs were \
+             weighed against every model of their size",
+            taken.fit.chi2,
+            self.label_set(&current.active),
+            current.chi2
+        ));
+        Ok(Some(taken))
+    }
+
+    /// Two knobs from the nominal that no chain accepts (each alone fails a rule: neither
+    /// cause alone is consistent or significant), judged together by the joint step's rules
+    /// (`judge_pair`: significant with 2 dof at α over every pair of knobs, each needed
+    /// beside the other, better held out, material, inside both ranges, consistent, its
+    /// effects beating the recalibration). Otherwise why not, as a clause for the note.
+    fn larger_as_pair(
+        &mut self,
+        set: &[usize],
+        f: &Fit,
+    ) -> Result<Result<(Vec<Step>, Fit), String>, GapError> {
+        let [a, b] = set else {
+            return Ok(Err(String::new()));
+        };
+        if !self.nominal.active.is_empty() {
+            return Ok(Err(String::new()));
+        }
+        let kk = self.ctx.knobs.list.len();
+        let alpha_pair = self.opts.alpha / (kk * kk.saturating_sub(1) / 2).max(1) as f64;
+        let nominal = self.nominal.clone();
+        Ok(match self.judge_pair(&nominal, (*a, *b), f, alpha_pair)? {
+            Ok((steps, baseline)) => {
+                if let Some(nb) = baseline {
+                    self.baseline = Some(nb);
+                }
+                Ok((steps, f.clone()))
+            }
+            Err(why) => Err(format!(
+                "; nor does the pair by the joint step's rules ({why})"
+            )),
+        })
     }
 
     /// The step of `label` made ambiguous with `rival` (a step with any rival names none).

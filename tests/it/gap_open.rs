@@ -2170,6 +2170,134 @@ fn the_within_noise_subset_names_the_true_pair_behind_a_look_alike_taken_first()
     );
 }
 
+/// An unreported 1.5° slope with hip viscous damping 0.0068 N·m·s/rad, on the expected trials
+/// of a test design whose uncertain parameters are the slope and the leg's fore–aft COM
+/// offset (`tests/data/gap/viscous-slope-expected.csv`, command in its `source` column). The
+/// COM offset alone explains more of the gap than either cause alone, so greedy forward
+/// selection takes it first and stops beyond noise; the look-ahead unnames it because slope +
+/// damping fits better (χ² 2.2 against 296 for the COM offset, measured 2026-12-03), but only
+/// takes names away: "partly explained, nothing named". With the within-noise rules the larger
+/// model itself, which fits within noise and whose knobs form a chain every rule accepts,
+/// replaces the answer and is weighed against the models of its size: both causes named,
+/// their truths inside their intervals, the stand-in not named.
+#[test]
+fn a_pair_within_noise_replaces_a_stand_in_a_greedy_first_step_took() {
+    let cache = bundled_walks();
+    let base = DiagnoseOptions {
+        effects: vec!["hip_viscous_damping".into(), "hip_coulomb_friction".into()],
+        calibrate: true,
+        explanations: false,
+        identifiability: false,
+        audit_undeclared: false,
+        ..DiagnoseOptions::default()
+    };
+    let without = DiagnoseOptions {
+        select: SelectOptions {
+            within_noise_subset: false,
+            ..SelectOptions::default()
+        },
+        ..base.clone()
+    };
+    let file = "viscous-slope-expected.csv";
+    let d = diagnose_committed_with(file, &without, cache);
+    assert_eq!(
+        d.answer.kind,
+        AnswerKind::PartlyExplained,
+        "{}",
+        d.answer.statement
+    );
+    assert!(
+        d.answer.effects.is_empty() && d.answer.parameters.is_empty(),
+        "named without the rule: {}",
+        d.answer.statement
+    );
+    let d = diagnose_committed_with(file, &base, cache);
+    assert_eq!(d.answer.kind, AnswerKind::Both, "{}", d.answer.statement);
+    assert_names(
+        &d,
+        &["mugatu-slope-com:ground.slope_deg"],
+        &["hip_viscous_damping"],
+    );
+    assert_interval_holds(&d.answer.parameters[0], 1.5);
+    assert_interval_holds(&d.answer.effects[0], 0.0068);
+}
+
+/// The same trials where the rule's premise fails: the true effect is not offered (hip
+/// Coulomb friction and backlash only). Slope + Coulomb friction, damping's look-alike, fits
+/// within noise (χ² 17.3 on 42 values, measured 2026-12-03), and the rule names it. This is
+/// what forward selection does whenever only a look-alike is offered (damping alone with
+/// Coulomb friction offered: Coulomb named, checked below), so the rule adds no new kind of
+/// wrong name; `gap diagnose` offers the whole library by default, where the look-alike
+/// search in the final model weighs damping against Coulomb friction. The test pins the
+/// limit so that a change to it is seen.
+#[test]
+fn a_look_alike_is_named_when_the_truth_is_not_offered() {
+    let cache = bundled_walks();
+    let opts = DiagnoseOptions {
+        effects: vec!["hip_coulomb_friction".into(), "hip_backlash".into()],
+        calibrate: true,
+        explanations: false,
+        identifiability: false,
+        audit_undeclared: false,
+        ..DiagnoseOptions::default()
+    };
+    let d = diagnose_committed_with("viscous-slope-expected.csv", &opts, cache);
+    assert_names(
+        &d,
+        &["mugatu-slope-com:ground.slope_deg"],
+        &["hip_coulomb_friction"],
+    );
+    let d = diagnose_committed_with("viscous-expected.csv", &opts, cache);
+    assert_names(&d, &[], &["hip_coulomb_friction"]);
+}
+
+/// The benchmark's compound cases "unreported 1.5° slope + hip Coulomb friction 0.0199 N·m"
+/// and "+ hip viscous damping 0.00676 N·m·s/rad" (2× thresholds, 3 % noise, their own draws:
+/// `tests/data/gap/coulomb-slope-3pct-bench.csv`, `viscous-slope-3pct-bench.csv`), diagnosed
+/// as the benchmark does (every effect, the 12 uncertain parameters calibrated, no audit).
+/// Forward selection takes the leg's fore–aft COM offset first (−57 %, each cause alone
+/// 8–16 %) and stops beyond noise: both were "partly explained, nothing named" (measured
+/// 2026-12-03). Coulomb: the look-ahead finds slope + Coulomb (the slope is significant
+/// alone), which no chain accepts (the slope alone is not one value for all conditions,
+/// Coulomb alone not significant) but the joint step's rules do. Damping: neither cause is
+/// significant alone, the look-ahead never sees the pair, and the joint search from the
+/// nominal finds it. Both named each time, truths inside their intervals.
+#[test]
+#[ignore = "heavy: about 300 s on 2 threads; tools/heavy-tests.sh"]
+fn a_slope_and_a_hip_loss_are_both_named_where_a_stand_in_explains_more_alone() {
+    let cache = bundled_walks();
+    let opts = DiagnoseOptions {
+        calibrate: true,
+        explanations: false,
+        identifiability: false,
+        audit_undeclared: false,
+        ..DiagnoseOptions::default()
+    };
+    for (file, effect, truth) in [
+        (
+            "coulomb-slope-3pct-bench.csv",
+            "hip_coulomb_friction",
+            0.019_881_386_413_663_705,
+        ),
+        (
+            "viscous-slope-3pct-bench.csv",
+            "hip_viscous_damping",
+            0.006_763_572_191_301_286,
+        ),
+    ] {
+        let d = diagnose_committed_with(file, &opts, cache);
+        assert_eq!(
+            d.answer.kind,
+            AnswerKind::Both,
+            "{file}: {}",
+            d.answer.statement
+        );
+        assert_names(&d, &["mugatu:ground.slope_deg"], &[effect]);
+        assert_interval_holds(&d.answer.parameters[0], 1.5);
+        assert_interval_holds(&d.answer.effects[0], truth);
+    }
+}
+
 /// Where the start sets the direction, the sign of a fore–aft mirror-odd parameter is not
 /// identified, and the diagnosis says so (`sign_identified`): the rule behind the speed
 /// comparison of `criteria.walking_direction = "either"` tested where its assumptions fail —
