@@ -501,6 +501,9 @@ const LOOK_ALIKE_WALKS: usize = STEP_WALKS;
 /// Pairs of knobs confirmed with walks at a joint step (the best by the surrogate).
 const JOINT_WALKS: usize = 3;
 
+/// A model taken in place of the answer: its knobs, its chain and its fit.
+type Accepted = (Vec<usize>, Vec<Step>, Fit);
+
 /// What one forward step found.
 enum Outcome {
     /// A knob passed every rule: the step, the model with it, and the new baseline of the
@@ -2088,32 +2091,58 @@ impl Selector<'_, '_> {
                 }
             }
         }
+        let Some((set, chain, fit)) = self.first_accepted(fits, false)? else {
+            return Ok(None);
+        };
+        self.notes.push(format!(
+            "{} fits these trials within noise (χ² {:.1}) inside a larger model the \
+             look-ahead found, and its knobs form a chain every rule accepts: it replaced \
+             {} (χ² {:.1}); the chain below is rebuilt from the nominal",
+            self.label_set(&set),
+            fit.chi2,
+            self.label_set(&current.active),
+            current.chi2
+        ));
+        Ok(Some((chain, fit)))
+    }
+
+    /// The first of `fits` (models within noise, inside their ranges) whose knobs form a
+    /// chain every forward rule accepts (rebuilt from the nominal) or, with `as_pair`, pass
+    /// the joint step's rules as two knobs from the nominal: its knobs, its chain ended at
+    /// the better-fitting of the two models (with its held-out χ²) and that model. A note
+    /// says why each better-fitting one was not taken.
+    fn first_accepted(
+        &mut self,
+        mut fits: Vec<(Vec<usize>, Fit)>,
+        as_pair: bool,
+    ) -> Result<Option<Accepted>, GapError> {
         fits.sort_by(|a, b| a.1.chi2.total_cmp(&b.1.chi2));
-        for (sub, f) in fits {
-            let (mut chain, built) = match self.rebuild_chain(&sub)? {
+        for (set, f) in fits {
+            let rebuilt = match self.rebuild_chain(&set)? {
+                Ok(built) => Ok(built),
+                Err(why) if as_pair => match self.larger_as_pair(&set, &f)? {
+                    Ok(taken) => Ok(taken),
+                    Err(why_pair) => Err(format!("({why}){why_pair}")),
+                },
+                Err(why) => Err(format!("({why})")),
+            };
+            let (mut chain, built) = match rebuilt {
                 Ok(built) => built,
                 Err(why) => {
                     self.notes.push(format!(
                         "{} fits these trials within noise (χ² {:.1}) but its knobs do not form \
-                         a chain every rule accepts ({why}): not taken",
-                        self.label_set(&sub),
+                         a chain every rule accepts {why}: not taken",
+                        self.label_set(&set),
                         f.chi2
                     ));
                     continue;
                 }
             };
-            let fit = ctx.with_held_out(if f.chi2 < built.chi2 { f } else { built });
-            self.notes.push(format!(
-                "{} fits these trials within noise (χ² {:.1}) inside a larger model the \
-                 look-ahead found, and its knobs form a chain every rule accepts: it replaced \
-                 {} (χ² {:.1}); the chain below is rebuilt from the nominal",
-                self.label_set(&sub),
-                fit.chi2,
-                self.label_set(&current.active),
-                current.chi2
-            ));
+            let fit = self
+                .ctx
+                .with_held_out(if f.chi2 < built.chi2 { f } else { built });
             self.end_chain_at(&mut chain, &fit);
-            return Ok(Some((chain, fit)));
+            return Ok(Some((set, chain, fit)));
         }
         Ok(None)
     }
@@ -2132,53 +2161,26 @@ impl Selector<'_, '_> {
         larger: &[(Vec<usize>, Fit)],
         current: &Fit,
     ) -> Result<Option<(Vec<Step>, Fit)>, GapError> {
-        let ctx = self.ctx;
-        let mut fits: Vec<&(Vec<usize>, Fit)> = larger
+        let fits: Vec<(Vec<usize>, Fit)> = larger
             .iter()
             .filter(|(_, f)| within_noise(f, self.n, self.opts.alpha) && inside_ranges(f))
+            .cloned()
             .collect();
-        fits.sort_by(|a, b| a.1.chi2.total_cmp(&b.1.chi2));
-        for (set, f) in fits {
-            let (mut chain, built) = match self.rebuild_chain(set)? {
-                Ok(built) => built,
-                Err(why) => match self.larger_as_pair(set, f)? {
-                    Ok(taken) => taken,
-                    Err(why_pair) => {
-                        self.notes.push(format!(
-                            "{} fits these trials within noise (χ² {:.1}) but its knobs do not \
-                             form a chain every rule accepts ({why}){why_pair}: not taken",
-                            self.label_set(set),
-                            f.chi2
-                        ));
-                        continue;
-                    }
-                },
-            };
-            let fit = if f.chi2 < built.chi2 && f.held_out.is_some() {
-                f.clone()
-            } else {
-                ctx.with_held_out(if f.chi2 < built.chi2 {
-                    f.clone()
-                } else {
-                    built
-                })
-            };
-            self.notes.push(format!(
-                "{} fits these trials within noise (χ² {:.1}), {} does not (χ² {:.1}), and no \
-                 model of that size inside it does; its knobs form a chain every rule accepts, or \
-                 pass the joint step's rules together (forward selection took a knob that \
-                 alone explains more): it replaced the \
-                 answer, and its knobs were weighed against every model of their size; the \
-                 chain below is rebuilt from the nominal",
-                self.label_set(set),
-                fit.chi2,
-                self.label_set(&current.active),
-                current.chi2
-            ));
-            self.end_chain_at(&mut chain, &fit);
-            return Ok(Some((chain, fit)));
-        }
-        Ok(None)
+        let Some((set, chain, fit)) = self.first_accepted(fits, true)? else {
+            return Ok(None);
+        };
+        self.notes.push(format!(
+            "{} fits these trials within noise (χ² {:.1}), {} does not (χ² {:.1}), and no \
+             model of that size inside it does; its knobs form a chain every rule accepts, or \
+             pass the joint step's rules together (forward selection took a knob that alone \
+             explains more): it replaced the answer, and its knobs were weighed against every \
+             model of their size; the chain below is rebuilt from the nominal",
+            self.label_set(&set),
+            fit.chi2,
+            self.label_set(&current.active),
+            current.chi2
+        ));
+        Ok(Some((chain, fit)))
     }
 
     /// A pair of knobs from the nominal in place of an answer of one knob that leaves the
@@ -2193,9 +2195,6 @@ impl Selector<'_, '_> {
     /// (it named a look-alike on a noise draw); here the pair must explain the whole gap,
     /// and the caller weighs it against every model of its size and one size up.
     fn within_noise_pair(&mut self, current: &Fit) -> Result<Option<JointTaken>, GapError> {
-        if !self.nominal.active.is_empty() {
-            return Ok(None);
-        }
         let nominal = self.nominal.clone();
         // Far beyond noise on the surrogate (another engine's trials), no pair is walked.
         let reach = Some(SUBSET_REACH_CHI2_PER_DOF);
@@ -2251,12 +2250,10 @@ impl Selector<'_, '_> {
         set: &[usize],
         f: &Fit,
     ) -> Result<Result<(Vec<Step>, Fit), String>, GapError> {
+        // The nominal has no free knob (`FitContext::nominal`): a pair from it is the whole model.
         let [a, b] = set else {
             return Ok(Err(String::new()));
         };
-        if !self.nominal.active.is_empty() {
-            return Ok(Err(String::new()));
-        }
         let kk = self.ctx.knobs.list.len();
         let alpha_pair = self.opts.alpha / (kk * kk.saturating_sub(1) / 2).max(1) as f64;
         let nominal = self.nominal.clone();

@@ -2183,23 +2183,13 @@ fn the_within_noise_subset_names_the_true_pair_behind_a_look_alike_taken_first()
 #[test]
 fn a_pair_within_noise_replaces_a_stand_in_a_greedy_first_step_took() {
     let cache = bundled_walks();
-    let base = DiagnoseOptions {
-        effects: vec!["hip_viscous_damping".into(), "hip_coulomb_friction".into()],
-        calibrate: true,
-        explanations: false,
-        identifiability: false,
-        audit_undeclared: false,
-        ..DiagnoseOptions::default()
-    };
-    let without = DiagnoseOptions {
-        select: SelectOptions {
-            within_noise_subset: false,
-            ..SelectOptions::default()
-        },
-        ..base.clone()
+    let effects = ["hip_viscous_damping", "hip_coulomb_friction"];
+    let without = SelectOptions {
+        within_noise_subset: false,
+        ..SelectOptions::default()
     };
     let file = "viscous-slope-expected.csv";
-    let d = diagnose_committed_with(file, &without, cache);
+    let d = diagnose_committed(file, &effects, &without, false, cache);
     assert_eq!(
         d.answer.kind,
         AnswerKind::PartlyExplained,
@@ -2211,7 +2201,7 @@ fn a_pair_within_noise_replaces_a_stand_in_a_greedy_first_step_took() {
         "named without the rule: {}",
         d.answer.statement
     );
-    let d = diagnose_committed_with(file, &base, cache);
+    let d = diagnose_committed(file, &effects, &SelectOptions::default(), false, cache);
     assert_eq!(d.answer.kind, AnswerKind::Both, "{}", d.answer.statement);
     assert_names(
         &d,
@@ -2233,21 +2223,16 @@ fn a_pair_within_noise_replaces_a_stand_in_a_greedy_first_step_took() {
 #[test]
 fn a_look_alike_is_named_when_the_truth_is_not_offered() {
     let cache = bundled_walks();
-    let opts = DiagnoseOptions {
-        effects: vec!["hip_coulomb_friction".into(), "hip_backlash".into()],
-        calibrate: true,
-        explanations: false,
-        identifiability: false,
-        audit_undeclared: false,
-        ..DiagnoseOptions::default()
-    };
-    let d = diagnose_committed_with("viscous-slope-expected.csv", &opts, cache);
+    let effects = ["hip_coulomb_friction", "hip_backlash"];
+    let select = SelectOptions::default();
+    let diagnose = |file: &str| diagnose_committed(file, &effects, &select, false, cache);
+    let d = diagnose("viscous-slope-expected.csv");
     assert_names(
         &d,
         &["mugatu-slope-com:ground.slope_deg"],
         &["hip_coulomb_friction"],
     );
-    let d = diagnose_committed_with("viscous-expected.csv", &opts, cache);
+    let d = diagnose("viscous-expected.csv");
     assert_names(&d, &[], &["hip_coulomb_friction"]);
 }
 
@@ -2266,13 +2251,7 @@ fn a_look_alike_is_named_when_the_truth_is_not_offered() {
 #[ignore = "heavy: about 300 s on 2 threads; tools/heavy-tests.sh"]
 fn a_slope_and_a_hip_loss_are_both_named_where_a_stand_in_explains_more_alone() {
     let cache = bundled_walks();
-    let opts = DiagnoseOptions {
-        calibrate: true,
-        explanations: false,
-        identifiability: false,
-        audit_undeclared: false,
-        ..DiagnoseOptions::default()
-    };
+    let select = SelectOptions::default();
     for (file, effect, truth) in [
         (
             "coulomb-slope-3pct-bench.csv",
@@ -2285,7 +2264,8 @@ fn a_slope_and_a_hip_loss_are_both_named_where_a_stand_in_explains_more_alone() 
             0.006_763_572_191_301_286,
         ),
     ] {
-        let d = diagnose_committed_with(file, &opts, cache);
+        // No effects listed: the whole library, as the benchmark diagnoses.
+        let d = diagnose_committed(file, &[], &select, false, cache);
         assert_eq!(
             d.answer.kind,
             AnswerKind::Both,
