@@ -111,6 +111,9 @@ pub enum Verdict {
     NoGap,
     /// One candidate fits within noise and every rival is worse beyond the test.
     Named { knob: String },
+    /// Two candidates at once ([`PairFit`]): the pair fits within noise, beats each of its
+    /// knobs alone beyond the test, and no other pair does.
+    NamedTogether { knobs: Vec<String> },
     /// The candidates within reach of the best: the trials cannot tell them apart.
     CannotTell { group: Vec<String> },
     /// No candidate fits within noise; where the best one's rest lies.
@@ -134,6 +137,34 @@ pub struct Ranking {
     /// (within noise when ≥ α).
     pub best_p_value: f64,
     pub verdict: Verdict,
+    /// The best candidate with each plausible rival fitted together (summaries + waveforms
+    /// only): [`check_pairs`].
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub pairs: Vec<PairFit>,
+}
+
+/// Two candidates fitted together on walks (the profile of the second, the first refitted
+/// at each of its nodes).
+#[derive(Clone, Debug, Serialize)]
+pub struct PairFit {
+    pub knobs: [String; 2],
+    /// Fitted values (SI at the first design's 1× for effects; the field's unit otherwise).
+    pub values: [f64; 2],
+    pub units: [String; 2],
+    pub chi2_summaries: f64,
+    pub chi2_waveforms: f64,
+    /// (χ² of each knob alone − the pair's) / over-dispersion, in the evidence the pair is
+    /// tested on: the likelihood-ratio statistic (1 dof) of the other knob beside it.
+    pub delta: [f64; 2],
+    /// The values of the second knob beside the first that the profile does not reject at
+    /// 95 %, at the grid's resolution (low, high; SI): the grid nodes just outside the kept
+    /// ones, or a range end. "This knob, with that much of the other at most".
+    pub second_range: [f64; 2],
+    /// Named together (every rule below passed).
+    pub passes: bool,
+    /// Why not, when it does not pass.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub why_not: Option<String>,
 }
 
 /// Cycles of one trial for the figure: measured, nominal and best candidate (waveform mode).
@@ -447,6 +478,7 @@ fn separate_carried(
                 overdispersion: 1.0,
                 best_p_value: f64::NAN,
                 verdict: Verdict::NotComparable { why: why.clone() },
+                pairs: Vec::new(),
             }],
             cycles: Vec::new(),
             notes: carrying.notes.clone(),
@@ -643,6 +675,14 @@ pub fn separate_with(
         }
         rankings.push(fitted.ranking(mi, mode));
     }
+    // A mixture of two candidates: only the cycles can tell one (a single knob fits the
+    // summaries of two hip losses within noise), so pairs are weighed with them.
+    if let Some(r) = rankings
+        .iter_mut()
+        .find(|r| r.evidence == Evidence::SummariesAndWaveforms)
+    {
+        check_pairs(&walker, &knobs, &obs, sigs, opts, r)?;
+    }
     let cycles = fitted.cycles(set, &rankings, &nominal);
     Ok(Separation {
         trials: set.trials.len(),
@@ -730,9 +770,27 @@ fn fit_candidate(
     sigs: &[Option<CycleSignature>],
     opts: &SeparateOptions,
 ) -> Result<[Best; 2], GapError> {
+    let by_summary = fit_one(walker, knobs, k, obs, sigs, opts, &|s, _| s)?;
+    let by_both = fit_one(walker, knobs, k, obs, sigs, opts, &|s, w| s + w)?;
+    Ok([by_summary, by_both])
+}
+
+/// One knob alone (the rest at the file's values) fitted by `cost(summaries χ², cycles χ²)`:
+/// its grid, then a golden section between the best node's neighbours, on walks (the grid's
+/// walks are shared through the cache by every cost).
+#[allow(clippy::too_many_arguments)]
+fn fit_one(
+    walker: &Walker,
+    knobs: &Knobs,
+    k: usize,
+    obs: &[Observation],
+    sigs: &[Option<CycleSignature>],
+    opts: &SeparateOptions,
+    cost: &dyn Fn(f64, f64) -> f64,
+) -> Result<Best, GapError> {
     let knob = &knobs.list[k];
     let label = knob.label();
-    let eval = |x: f64| -> Result<(Arc<Vec<SimCycle>>, f64, f64), GapError> {
+    let eval = |x: f64| -> Result<Best, GapError> {
         let mut point = knobs.nominal_point();
         point[k] = Some(x);
         let sims = walker.run(
@@ -740,45 +798,35 @@ fn fit_candidate(
             &knobs.setting(walker.lib, &point),
         )?;
         let (s, w) = chi2_pair(obs, sigs, &sims, opts.relative_floor);
-        Ok((sims, s, w))
+        Ok(Best { x, sims, s, w })
     };
     let nodes = knob.nodes(opts.grid_points);
-    let mut grid = Vec::with_capacity(nodes.len());
-    for &x in &nodes {
-        grid.push(eval(x)?);
-    }
-    let pick = |mode: Evidence| -> Result<Best, GapError> {
-        let cost = |s: f64, w: f64| match mode {
-            Evidence::Summaries => s,
-            Evidence::SummariesAndWaveforms => s + w,
-        };
-        let j = (0..nodes.len())
-            .min_by(|a, b| cost(grid[*a].1, grid[*a].2).total_cmp(&cost(grid[*b].1, grid[*b].2)))
-            .unwrap_or(0);
-        let mut best = Best {
-            x: nodes[j],
-            sims: grid[j].0.clone(),
-            s: grid[j].1,
-            w: grid[j].2,
-        };
-        // Golden section between the best node's neighbours on walks: refine_steps + 1
-        // walk sets (two open the bracket), kept only where it beats the node.
-        let (a, b) = (
-            nodes[j.saturating_sub(1)],
-            nodes[(j + 1).min(nodes.len() - 1)],
-        );
-        let (x, c, (sims, s, w)) =
-            super::solver::golden_section(a, b, opts.refine_steps.saturating_sub(1), |x| {
-                eval(x).map(|(sims, s, w)| (cost(s, w), (sims, s, w)))
-            })?;
-        if c < cost(best.s, best.w) {
-            best = Best { x, sims, s, w };
+    let mut best: Option<(usize, Best)> = None;
+    for (j, &x) in nodes.iter().enumerate() {
+        let b = eval(x)?;
+        if best
+            .as_ref()
+            .is_none_or(|(_, q)| cost(b.s, b.w) < cost(q.s, q.w))
+        {
+            best = Some((j, b));
         }
-        Ok(best)
-    };
-    let by_summary = pick(Evidence::Summaries)?;
-    let by_both = pick(Evidence::SummariesAndWaveforms)?;
-    Ok([by_summary, by_both])
+    }
+    let (j, best) = best.ok_or_else(|| GapError::Invalid("a knob with no grid".into()))?;
+    // Golden section between the best node's neighbours on walks: refine_steps + 1 walk
+    // sets (two open the bracket), kept only where it beats the node.
+    let (a, b) = (
+        nodes[j.saturating_sub(1)],
+        nodes[(j + 1).min(nodes.len() - 1)],
+    );
+    let (_, c, refined) =
+        super::solver::golden_section(a, b, opts.refine_steps.saturating_sub(1), |x| {
+            eval(x).map(|q| (cost(q.s, q.w), q))
+        })?;
+    Ok(if c < cost(best.s, best.w) {
+        refined
+    } else {
+        best
+    })
 }
 
 /// The candidates' fits, ready to be ranked.
@@ -825,19 +873,7 @@ impl Fitted<'_> {
         // metric rejects is plausible, since that metric's misfit may be the engines' versions
         // of the effect answering it apart (`reference::within_noise_but_one_metric`,
         // measured on Drake's hip Coulomb friction 0.08 N·m: the yaw swing).
-        let summaries_p = |b: &Best| {
-            let p = (nb * chi2_upper_p(b.s, dof(obs.len())).unwrap_or(0.0)).min(1.0);
-            if !opts.through_reference {
-                return p;
-            }
-            super::reference::within_noise_but_one(
-                obs,
-                |o| b.sims[o.trial].metrics.get(o.metric),
-                1,
-                opts.alpha / nb,
-            )
-            .map_or(p, |w| p.max((nb * w.p_left).min(1.0)))
-        };
+        let summaries_p = |b: &Best| summaries_p_value(obs, &b.sims, b.s, 1, nb, opts);
         // Each candidate with its summaries' p-value, computed once.
         let mut ranked: Vec<(CandidateFit, f64)> = self
             .idx
@@ -982,6 +1018,7 @@ impl Fitted<'_> {
             overdispersion: phi,
             best_p_value: best_p,
             verdict,
+            pairs: Vec::new(),
         }
     }
 
@@ -1253,6 +1290,27 @@ pub fn follow_up_with(
             {
                 out.named.push(knob.clone());
             }
+            (
+                FollowPurpose::Ambiguous | FollowPurpose::Explore,
+                Verdict::NamedTogether { knobs },
+            ) => {
+                for k in knobs {
+                    if !out.named.contains(k) {
+                        out.named.push(k.clone());
+                    }
+                }
+            }
+            // A pair holding the answer's knob confirms it and adds the other; a pair
+            // without it withdraws it, and (as a rival named instead) adds nothing.
+            (FollowPurpose::Confirm { knob }, Verdict::NamedTogether { knobs })
+                if knobs.contains(knob) =>
+            {
+                for k in knobs {
+                    if !out.named.contains(k) {
+                        out.named.push(k.clone());
+                    }
+                }
+            }
             (FollowPurpose::Confirm { knob }, v) if v != &Verdict::Named { knob: knob.clone() } => {
                 out.named.retain(|k| k != knob);
                 out.withdrawn.push(format!(
@@ -1276,6 +1334,7 @@ pub fn verdict_words(v: &Verdict) -> String {
     match v {
         Verdict::NoGap => "no gap".into(),
         Verdict::Named { knob } => format!("they name {knob}"),
+        Verdict::NamedTogether { knobs } => format!("they name {} together", knobs.join(" and ")),
         Verdict::CannotTell { group } => format!("cannot tell {}", group.join(" from ")),
         Verdict::NoneFits { rest_in } => format!("none fits; the rest lies in {rest_in}"),
         Verdict::NotComparable { .. } => {
@@ -1322,4 +1381,267 @@ pub fn follow_up(
         &CycleCache::default(),
         progress,
     )
+}
+
+/// The summaries' p-value of a fit with `k` free knobs (Bonferroni over `blocks` blocks of
+/// evidence); through a reference the larger of it and the p-value without the one metric
+/// that misses most: a candidate only one metric rejects is plausible, since that metric's
+/// misfit may be the engines' versions of the effect answering it apart
+/// (`reference::within_noise_but_one_metric`, measured on Drake's hip Coulomb friction
+/// 0.08 N·m: the yaw swing).
+fn summaries_p_value(
+    obs: &[Observation],
+    sims: &[SimCycle],
+    chi2: f64,
+    k: usize,
+    blocks: f64,
+    opts: &SeparateOptions,
+) -> f64 {
+    let dof = (obs.len().max(k + 1) - k) as f64;
+    let p = (blocks * chi2_upper_p(chi2, dof).unwrap_or(0.0)).min(1.0);
+    if !opts.through_reference {
+        return p;
+    }
+    super::reference::within_noise_but_one(
+        obs,
+        |o| sims[o.trial].metrics.get(o.metric),
+        k,
+        opts.alpha / blocks,
+    )
+    .map_or(p, |w| p.max((blocks * w.p_left).min(1.0)))
+}
+
+/// χ²₁'s 95 % point: a profile's bound.
+const CHI2_1_95: f64 = 3.841_458_820_694_124;
+
+/// The best candidate of the summaries + waveforms ranking fitted together with each rival
+/// ([`pair_profile`]); a pair is named ([`Verdict::NamedTogether`]) when it is the only one
+/// that passes every rule:
+/// * each knob is needed beside the other: the pair beats each knob alone by the
+///   likelihood-ratio test (1 dof, Δχ² over the ranking's over-dispersion) at α over the
+///   pairs tried;
+/// * neither value sits at an end of its range;
+/// * it fits within noise in both blocks of evidence (Bonferroni over them; the summaries
+///   by the ranking's rule, which through a reference forgives one metric).
+///
+/// The evidence is the ranking's: summaries + cycles χ², or through a reference the cycles'
+/// χ² alone (the summaries only judge plausibility there: which look-alike carried
+/// summaries favour is the engines' business). Measured on Drake-Lagged through its
+/// no-effect trials, noise-free: viscous damping 0.02 N·m·s/rad with Coulomb friction 0.05
+/// N·m fit the cycles at χ² 11.4 as a pair against 29.1 for damping alone (on 372
+/// coefficients), while Coulomb friction 0.065 N·m alone gains 0.4 from a damping beside
+/// it and damping 0.025 alone nothing from Coulomb friction; on the summaries + cycles the
+/// same Coulomb friction would have gained 12.5 from a spurious damping (the summaries'
+/// engine difference), hence the cycles alone.
+///
+/// Where no pair passes, each pair still says how much of the second knob the profile does
+/// not reject beside the first (`PairFit::second_upper`): a single name is then "this, with
+/// up to so much of that".
+fn check_pairs(
+    walker: &Walker,
+    knobs: &Knobs,
+    obs: &[Observation],
+    sigs: &[Option<CycleSignature>],
+    opts: &SeparateOptions,
+    r: &mut Ranking,
+) -> Result<(), GapError> {
+    let judged = matches!(
+        r.verdict,
+        Verdict::Named { .. } | Verdict::CannotTell { .. } | Verdict::NoneFits { .. }
+    );
+    if !judged || r.fits.len() < 2 {
+        return Ok(());
+    }
+    let n_wave: usize = sigs.iter().flatten().map(coefficient_count).sum();
+    let cycles_decide = opts.through_reference && n_wave > 0;
+    let cost: &dyn Fn(f64, f64) -> f64 = if cycles_decide {
+        &|_, w| w
+    } else {
+        &|s, w| s + w
+    };
+    let blocks = if n_wave > 0 { 2.0 } else { 1.0 };
+    let Some(a) = knobs.index_of(&r.fits[0].knob) else {
+        return Ok(());
+    };
+    let rivals: Vec<usize> = r.fits[1..]
+        .iter()
+        .filter_map(|f| knobs.index_of(&f.knob))
+        .collect();
+    let per_test = opts.alpha / rivals.len().max(1) as f64;
+    let needed = |d: f64| chi2_upper_p(d.max(0.0), 1.0).unwrap_or(1.0) < per_test;
+    let phi = r.overdispersion.max(1.0);
+    let alone_a = fit_one(walker, knobs, a, obs, sigs, opts, cost)?;
+    let (ka, wave_dof) = (&knobs.list[a], (n_wave.max(3) - 2) as f64);
+    let at_end = |k: &super::knob::Knob, x: f64| {
+        let span = k.hi - k.lo;
+        (x - k.lo).abs() < 1e-3 * span || (k.hi - x).abs() < 1e-3 * span
+    };
+    let mut pairs = Vec::with_capacity(rivals.len());
+    for b in rivals {
+        let kb = &knobs.list[b];
+        let alone_b = fit_one(walker, knobs, b, obs, sigs, opts, cost)?;
+        let (profile, best) = pair_profile(walker, knobs, a, b, obs, sigs, opts, cost)?;
+        let c = cost(best.s, best.w);
+        let delta = [
+            (cost(alone_a.s, alone_a.w) - c) / phi,
+            (cost(alone_b.s, alone_b.w) - c) / phi,
+        ];
+        let p_summaries = summaries_p_value(obs, &best.sims, best.s, 2, blocks, opts);
+        let p_cycles = if n_wave > 0 {
+            (blocks * chi2_upper_p(best.w, wave_dof).unwrap_or(0.0)).min(1.0)
+        } else {
+            1.0
+        };
+        let why_not = if !needed(delta[0]) {
+            Some(format!(
+                "{} is not needed beside {} (Δ {:.1})",
+                kb.label(),
+                ka.label(),
+                delta[0]
+            ))
+        } else if !needed(delta[1]) {
+            Some(format!(
+                "{} is not needed beside {} (Δ {:.1})",
+                ka.label(),
+                kb.label(),
+                delta[1]
+            ))
+        } else if at_end(ka, best.xa) || at_end(kb, best.xb) {
+            Some("a value at an end of its range".to_string())
+        } else if p_summaries < opts.alpha || p_cycles < opts.alpha {
+            Some(format!(
+                "it does not fit within noise (p {:.2e} on the summaries, {:.2e} on the cycles)",
+                p_summaries, p_cycles
+            ))
+        } else {
+            None
+        };
+        // The profile's 95 % range of the second knob, at the grid's resolution: from the
+        // node below the first one the profile does not reject to the node above the last.
+        let floor = profile.iter().map(|q| cost(q.s, q.w)).fold(c, f64::min);
+        let kept = |q: &PairPoint| cost(q.s, q.w) <= floor + CHI2_1_95 * phi;
+        let first = profile.iter().position(kept).unwrap_or(0);
+        let last = profile.iter().rposition(kept).unwrap_or(profile.len() - 1);
+        let ends = [
+            profile[first.saturating_sub(1)].xb,
+            profile[(last + 1).min(profile.len() - 1)].xb,
+        ];
+        let (lo, hi) = (kb.si(ends[0]), kb.si(ends[1]));
+        let second_range = [lo.min(hi), lo.max(hi)];
+        pairs.push(PairFit {
+            knobs: [ka.label(), kb.label()],
+            values: [ka.si(best.xa), kb.si(best.xb)],
+            units: [ka.unit.clone(), kb.unit.clone()],
+            chi2_summaries: best.s,
+            chi2_waveforms: best.w,
+            delta,
+            second_range,
+            passes: why_not.is_none(),
+            why_not,
+        });
+    }
+    let passing: Vec<&PairFit> = pairs.iter().filter(|p| p.passes).collect();
+    if let [p] = passing.as_slice() {
+        r.verdict = Verdict::NamedTogether {
+            knobs: p.knobs.to_vec(),
+        };
+    }
+    r.pairs = pairs;
+    Ok(())
+}
+
+/// One point of a pair's profile: knob `b` held at `xb`, knob `a` refitted on walks.
+#[derive(Clone)]
+struct PairPoint {
+    xa: f64,
+    xb: f64,
+    sims: Arc<Vec<SimCycle>>,
+    s: f64,
+    w: f64,
+}
+
+/// The profile of knob `b` beside knob `a` (both free, the rest at the file's values): at
+/// each of `b`'s grid nodes, `a` fitted by its grid and a golden section on walks, by
+/// `cost(summaries χ², cycles χ²)`; then `b` refined by a golden section between the best
+/// node's neighbours, `a` refitted inside the bracket its neighbours' fits span. Returns the
+/// nodes' fits (in `b`'s order) and the refined best.
+#[allow(clippy::too_many_arguments)]
+fn pair_profile(
+    walker: &Walker,
+    knobs: &Knobs,
+    a: usize,
+    b: usize,
+    obs: &[Observation],
+    sigs: &[Option<CycleSignature>],
+    opts: &SeparateOptions,
+    cost: &dyn Fn(f64, f64) -> f64,
+) -> Result<(Vec<PairPoint>, PairPoint), GapError> {
+    let (ka, kb) = (&knobs.list[a], &knobs.list[b]);
+    let label = format!("{}|{}", ka.label(), kb.label());
+    let eval = |xa: f64, xb: f64| -> Result<PairPoint, GapError> {
+        let mut point = knobs.nominal_point();
+        point[a] = Some(xa);
+        point[b] = Some(xb);
+        let sims = walker.run(
+            (format!("{label}={:x}", xb.to_bits()), xa.to_bits()),
+            &knobs.setting(walker.lib, &point),
+        )?;
+        let (s, w) = chi2_pair(obs, sigs, &sims, opts.relative_floor);
+        Ok(PairPoint { xa, xb, sims, s, w })
+    };
+    let steps = opts.refine_steps.saturating_sub(1);
+    // `a` fitted with `b` at `xb`, inside [lo, hi] (a grid first when it is `a`'s range).
+    let fit_a = |xb: f64, lo: f64, hi: f64, grid: bool| -> Result<PairPoint, GapError> {
+        let (lo, hi) = if grid {
+            let nodes = ka.nodes(opts.grid_points);
+            let mut best: Option<(usize, PairPoint)> = None;
+            for (j, &x) in nodes.iter().enumerate() {
+                let p = eval(x, xb)?;
+                if best
+                    .as_ref()
+                    .is_none_or(|(_, q)| cost(p.s, p.w) < cost(q.s, q.w))
+                {
+                    best = Some((j, p));
+                }
+            }
+            let (j, p) = best.ok_or_else(|| GapError::Invalid("empty knob grid".into()))?;
+            let bracket = (
+                nodes[j.saturating_sub(1)],
+                nodes[(j + 1).min(nodes.len() - 1)],
+            );
+            let (_, c, q) = super::solver::golden_section(bracket.0, bracket.1, steps, |x| {
+                eval(x, xb).map(|q| (cost(q.s, q.w), q))
+            })?;
+            return Ok(if c < cost(p.s, p.w) { q } else { p });
+        } else {
+            (lo, hi)
+        };
+        let (_, _, q) = super::solver::golden_section(lo, hi, steps, |x| {
+            eval(x, xb).map(|q| (cost(q.s, q.w), q))
+        })?;
+        Ok(q)
+    };
+    let nodes_b = kb.nodes(opts.grid_points);
+    let mut profile = Vec::with_capacity(nodes_b.len());
+    for &xb in &nodes_b {
+        profile.push(fit_a(xb, ka.lo, ka.hi, true)?);
+    }
+    let j = (0..profile.len())
+        .min_by(|x, y| {
+            cost(profile[*x].s, profile[*x].w).total_cmp(&cost(profile[*y].s, profile[*y].w))
+        })
+        .unwrap_or(0);
+    let (jl, jh) = (j.saturating_sub(1), (j + 1).min(profile.len() - 1));
+    let step_a = (ka.hi - ka.lo) / (opts.grid_points.max(2) - 1) as f64;
+    let a_lo = (profile[jl].xa.min(profile[jh].xa) - step_a).max(ka.lo);
+    let a_hi = (profile[jl].xa.max(profile[jh].xa) + step_a).min(ka.hi);
+    let (_, c, refined) = super::solver::golden_section(nodes_b[jl], nodes_b[jh], steps, |xb| {
+        fit_a(xb, a_lo, a_hi, false).map(|q| (cost(q.s, q.w), q))
+    })?;
+    let best = if c < cost(profile[j].s, profile[j].w) {
+        refined
+    } else {
+        profile[j].clone()
+    };
+    Ok((profile, best))
 }

@@ -197,7 +197,10 @@ pub fn run(
                         let m = usize::from(r.evidence == Evidence::SummariesAndWaveforms);
                         match &r.verdict {
                             Verdict::Named { knob } if knob == truth => cell.correct[m] += 1,
-                            Verdict::Named { .. } => cell.confused[m] += 1,
+                            // A pair on a single truth names a knob outside it.
+                            Verdict::Named { .. } | Verdict::NamedTogether { .. } => {
+                                cell.confused[m] += 1
+                            }
                             Verdict::CannotTell { .. } => cell.cannot_tell[m] += 1,
                             Verdict::NoneFits { .. } | Verdict::NotComparable { .. } => {
                                 cell.none_fits[m] += 1

@@ -21,6 +21,11 @@ fn verdict_text(v: &Verdict) -> String {
         Verdict::Named { knob } => {
             format!("**{knob}**: it fits within noise and every rival is worse beyond the test")
         }
+        Verdict::NamedTogether { knobs } => format!(
+            "**{}** together: the pair fits within noise, each is needed beside the other, and \
+             no other pair passes",
+            knobs.join(" + ")
+        ),
         Verdict::CannotTell { group } => format!(
             "**cannot tell** {}: the trials do not separate them",
             group.join(" from ")
@@ -76,6 +81,45 @@ fn ranking_md(o: &mut String, r: &Ranking) {
                 "yes"
             } else {
                 "no"
+            }
+        );
+    }
+    o.push('\n');
+    if r.pairs.is_empty() {
+        return;
+    }
+    let _ = writeln!(
+        o,
+        "The best candidate with each rival, fitted together (the second knob's profile, the \
+         first refitted at each node). Δ: the likelihood-ratio statistic of the other knob \
+         beside each one alone; range: the second knob's values the profile does not reject at \
+         95 %, widened to the grid nodes just outside them.\n"
+    );
+    let _ = writeln!(
+        o,
+        "| pair | fitted values | χ² summaries | χ² cycles | Δ (second needed, first needed) | range of the second | named |"
+    );
+    let _ = writeln!(o, "|---|---|---|---|---|---|---|");
+    for p in &r.pairs {
+        let _ = writeln!(
+            o,
+            "| {} + {} | {} {}, {} {} | {} | {} | {}, {} | {} – {} {} | {} |",
+            p.knobs[0],
+            p.knobs[1],
+            sig(p.values[0]),
+            p.units[0],
+            sig(p.values[1]),
+            p.units[1],
+            sig(p.chi2_summaries),
+            sig(p.chi2_waveforms),
+            sig(p.delta[0]),
+            sig(p.delta[1]),
+            sig(p.second_range[0]),
+            sig(p.second_range[1]),
+            p.units[1],
+            match &p.why_not {
+                None => "yes".to_string(),
+                Some(w) => format!("no: {w}"),
             }
         );
     }
