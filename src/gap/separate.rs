@@ -800,33 +800,34 @@ fn fit_one(
         let (s, w) = chi2_pair(obs, sigs, &sims, opts.relative_floor);
         Ok(Best { x, sims, s, w })
     };
-    let nodes = knob.nodes(opts.grid_points);
-    let mut best: Option<(usize, Best)> = None;
+    grid_then_golden(
+        &knob.nodes(opts.grid_points),
+        opts.refine_steps.saturating_sub(1),
+        |x| eval(x).map(|q| (cost(q.s, q.w), q)),
+    )
+}
+
+/// A 1-D fit on walks: the grid `nodes`, then a golden section of `reductions` steps between
+/// the best node's neighbours (reductions + 2 evaluations), kept only where it beats the node.
+fn grid_then_golden<T>(
+    nodes: &[f64],
+    reductions: usize,
+    mut eval: impl FnMut(f64) -> Result<(f64, T), GapError>,
+) -> Result<T, GapError> {
+    let mut best: Option<(usize, f64, T)> = None;
     for (j, &x) in nodes.iter().enumerate() {
-        let b = eval(x)?;
-        if best
-            .as_ref()
-            .is_none_or(|(_, q)| cost(b.s, b.w) < cost(q.s, q.w))
-        {
-            best = Some((j, b));
+        let (c, t) = eval(x)?;
+        if best.as_ref().is_none_or(|(_, bc, _)| c < *bc) {
+            best = Some((j, c, t));
         }
     }
-    let (j, best) = best.ok_or_else(|| GapError::Invalid("a knob with no grid".into()))?;
-    // Golden section between the best node's neighbours on walks: refine_steps + 1 walk
-    // sets (two open the bracket), kept only where it beats the node.
+    let (j, c, t) = best.ok_or_else(|| GapError::Invalid("a knob with no grid".into()))?;
     let (a, b) = (
         nodes[j.saturating_sub(1)],
         nodes[(j + 1).min(nodes.len() - 1)],
     );
-    let (_, c, refined) =
-        super::solver::golden_section(a, b, opts.refine_steps.saturating_sub(1), |x| {
-            eval(x).map(|q| (cost(q.s, q.w), q))
-        })?;
-    Ok(if c < cost(best.s, best.w) {
-        refined
-    } else {
-        best
-    })
+    let (_, refined_c, refined) = super::solver::golden_section(a, b, reductions, eval)?;
+    Ok(if refined_c < c { refined } else { t })
 }
 
 /// The candidates' fits, ready to be ranked.
@@ -1290,21 +1291,9 @@ pub fn follow_up_with(
             {
                 out.named.push(knob.clone());
             }
-            (
-                FollowPurpose::Ambiguous | FollowPurpose::Explore,
-                Verdict::NamedTogether { knobs },
-            ) => {
-                for k in knobs {
-                    if !out.named.contains(k) {
-                        out.named.push(k.clone());
-                    }
-                }
-            }
-            // A pair holding the answer's knob confirms it and adds the other; a pair
-            // without it withdraws it, and (as a rival named instead) adds nothing.
-            (FollowPurpose::Confirm { knob }, Verdict::NamedTogether { knobs })
-                if knobs.contains(knob) =>
-            {
+            // A pair adds both knobs; one that confirms the answer must hold its knob (a pair
+            // without it withdraws it below and, as a rival named instead, adds nothing).
+            (p, Verdict::NamedTogether { knobs }) if !matches!(p, FollowPurpose::Confirm { knob } if !knobs.contains(knob)) => {
                 for k in knobs {
                     if !out.named.contains(k) {
                         out.named.push(k.clone());
@@ -1590,41 +1579,20 @@ fn pair_profile(
         Ok(PairPoint { xa, xb, sims, s, w })
     };
     let steps = opts.refine_steps.saturating_sub(1);
-    // `a` fitted with `b` at `xb`, inside [lo, hi] (a grid first when it is `a`'s range).
-    let fit_a = |xb: f64, lo: f64, hi: f64, grid: bool| -> Result<PairPoint, GapError> {
-        let (lo, hi) = if grid {
-            let nodes = ka.nodes(opts.grid_points);
-            let mut best: Option<(usize, PairPoint)> = None;
-            for (j, &x) in nodes.iter().enumerate() {
-                let p = eval(x, xb)?;
-                if best
-                    .as_ref()
-                    .is_none_or(|(_, q)| cost(p.s, p.w) < cost(q.s, q.w))
-                {
-                    best = Some((j, p));
-                }
-            }
-            let (j, p) = best.ok_or_else(|| GapError::Invalid("empty knob grid".into()))?;
-            let bracket = (
-                nodes[j.saturating_sub(1)],
-                nodes[(j + 1).min(nodes.len() - 1)],
-            );
-            let (_, c, q) = super::solver::golden_section(bracket.0, bracket.1, steps, |x| {
-                eval(x, xb).map(|q| (cost(q.s, q.w), q))
-            })?;
-            return Ok(if c < cost(p.s, p.w) { q } else { p });
-        } else {
-            (lo, hi)
-        };
-        let (_, _, q) = super::solver::golden_section(lo, hi, steps, |x| {
-            eval(x, xb).map(|q| (cost(q.s, q.w), q))
-        })?;
-        Ok(q)
+    let by_cost = |q: PairPoint| (cost(q.s, q.w), q);
+    // `a` fitted with `b` at `xb`: over `a`'s whole range, or by a golden section in [lo, hi].
+    let fit_a = |xb: f64| {
+        grid_then_golden(&ka.nodes(opts.grid_points), steps, |x| {
+            eval(x, xb).map(by_cost)
+        })
+    };
+    let fit_a_in = |xb: f64, lo: f64, hi: f64| {
+        super::solver::golden_section(lo, hi, steps, |x| eval(x, xb).map(by_cost)).map(|r| r.2)
     };
     let nodes_b = kb.nodes(opts.grid_points);
     let mut profile = Vec::with_capacity(nodes_b.len());
     for &xb in &nodes_b {
-        profile.push(fit_a(xb, ka.lo, ka.hi, true)?);
+        profile.push(fit_a(xb)?);
     }
     let j = (0..profile.len())
         .min_by(|x, y| {
@@ -1636,7 +1604,7 @@ fn pair_profile(
     let a_lo = (profile[jl].xa.min(profile[jh].xa) - step_a).max(ka.lo);
     let a_hi = (profile[jl].xa.max(profile[jh].xa) + step_a).min(ka.hi);
     let (_, c, refined) = super::solver::golden_section(nodes_b[jl], nodes_b[jh], steps, |xb| {
-        fit_a(xb, a_lo, a_hi, false).map(|q| (cost(q.s, q.w), q))
+        fit_a_in(xb, a_lo, a_hi).map(by_cost)
     })?;
     let best = if c < cost(profile[j].s, profile[j].w) {
         refined
