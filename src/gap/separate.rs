@@ -137,10 +137,27 @@ pub struct Ranking {
     /// (within noise when ≥ α).
     pub best_p_value: f64,
     pub verdict: Verdict,
+    /// Through a reference, with cycles: the one metric without which the best candidate's
+    /// carried summaries fit within noise, where they do not with it (its plausibility rests
+    /// on leaving that metric out). What lies there is either another cause outside the
+    /// candidates or the engines' versions of the effect answering that metric apart; the
+    /// trials do not say which, so the answer says so.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub summaries_left_out: Option<MetricLeftOut>,
     /// The best candidate with each plausible rival fitted together (summaries + waveforms
     /// only): [`check_pairs`].
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub pairs: Vec<PairFit>,
+}
+
+/// A metric the best candidate's summaries fit within noise only without
+/// ([`Ranking::summaries_left_out`]).
+#[derive(Clone, Debug, Serialize)]
+pub struct MetricLeftOut {
+    pub metric: String,
+    /// χ² of that metric's values at the best fit, and how many values it has.
+    pub chi2: f64,
+    pub values: usize,
 }
 
 /// Two candidates fitted together on walks (the profile of the second, the first refitted
@@ -478,6 +495,7 @@ fn separate_carried(
                 overdispersion: 1.0,
                 best_p_value: f64::NAN,
                 verdict: Verdict::NotComparable { why: why.clone() },
+                summaries_left_out: None,
                 pairs: Vec::new(),
             }],
             cycles: Vec::new(),
@@ -989,12 +1007,27 @@ impl Fitted<'_> {
             .map(|(n, _, c)| block_p(*c, *n))
             .fold(1.0f64, f64::min)
             >= opts.alpha;
+        let best_sims = &self.fits[self.position(&list[0].knob)][mi].sims;
+        // The best fits only through leaving one metric out (through a reference, with
+        // cycles): said beside the answer, whatever it is.
+        let summaries_left_out = if cycles_decide && best_plausible {
+            one_metric_left_out(obs, best_sims, 1, nb, opts).map(|w| MetricLeftOut {
+                metric: w.metric.column().to_string(),
+                chi2: w.chi2_metric,
+                values: obs.len() - w.n_left,
+            })
+        } else {
+            None
+        };
+        // Never "no gap" where the best candidate, no better than the nominal, "fits" only by
+        // leaving out one metric: the whole change may lie there (an actuation latency the
+        // candidates cannot draw moves only the peak torque, through a reference), so none
+        // fits, and the rest lies there.
         let verdict = if !lr_gap && nominal_fits {
             Verdict::NoGap
-        } else if best_p < opts.alpha {
-            let b = &self.fits[self.position(&list[0].knob)][mi];
+        } else if best_p < opts.alpha || (!lr_gap && summaries_left_out.is_some()) {
             Verdict::NoneFits {
-                rest_in: rest_in(obs, self.sigs, &b.sims, opts.relative_floor, mi == 1),
+                rest_in: rest_in(obs, self.sigs, best_sims, opts.relative_floor, mi == 1),
             }
         } else if !lr_gap {
             Verdict::NoGap
@@ -1019,6 +1052,7 @@ impl Fitted<'_> {
             overdispersion: phi,
             best_p_value: best_p,
             verdict,
+            summaries_left_out,
             pairs: Vec::new(),
         }
     }
@@ -1149,6 +1183,13 @@ pub struct FollowUp {
     pub named: Vec<String>,
     /// Names the cycles took away, with why.
     pub withdrawn: Vec<String>,
+    /// Groups not separated, with why (one holds a number the design does not declare).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub not_separated: Vec<String>,
+    /// Named knobs whose carried summaries fit only with one metric left out
+    /// ([`Ranking::summaries_left_out`]): the knob, with that metric.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub left_out: Vec<(String, MetricLeftOut)>,
 }
 
 /// Single-knob rivals a named knob is confirmed against.
@@ -1212,59 +1253,9 @@ pub fn follow_up_with(
     if sigs.iter().all(Option::is_none) {
         return Ok(out);
     }
-    // A group is the summaries' look-alikes; the truth may be a knob the diagnosis did not
-    // put in it (measured on Drake-Lagged: hip Coulomb friction 0.015 N·m left the group
-    // {viscous damping, μ}, and the cycles named viscous damping from it). So each group is
-    // separated together with its best single-knob rivals outside it.
-    let with_rivals = |group: &[String]| {
-        let mut g = group.to_vec();
-        g.extend(
-            d.single
-                .iter()
-                .filter(|f| !group.contains(&f.knob))
-                .take(CONFIRM_RIVALS)
-                .map(|f| f.knob.clone()),
-        );
-        g
-    };
-    let mut jobs: Vec<(FollowPurpose, Vec<String>)> = d
-        .answer
-        .ambiguous
-        .iter()
-        .filter(|g| g.len() >= 2)
-        .map(|g| (FollowPurpose::Ambiguous, with_rivals(g)))
-        .collect();
-    let beyond_noise = matches!(
-        d.answer.kind,
-        AnswerKind::PartlyExplained | AnswerKind::Unexplained
-    );
-    if answer_names.is_empty() && beyond_noise {
-        let mut group: Vec<String> = d.answer.leads.iter().map(|n| n.knob.clone()).collect();
-        for f in &d.single {
-            if group.len() >= EXPLORE_CANDIDATES {
-                break;
-            }
-            if !group.contains(&f.knob) {
-                group.push(f.knob.clone());
-            }
-        }
-        if group.len() >= 2 {
-            jobs.push((FollowPurpose::Explore, group));
-        }
-    }
-    if let [knob] = answer_names.as_slice() {
-        let mut group = vec![knob.clone()];
-        group.extend(
-            d.single
-                .iter()
-                .filter(|f| &f.knob != knob)
-                .take(CONFIRM_RIVALS)
-                .map(|f| f.knob.clone()),
-        );
-        if group.len() >= 2 {
-            jobs.push((FollowPurpose::Confirm { knob: knob.clone() }, group));
-        }
-    }
+    let single: Vec<String> = d.single.iter().map(|f| f.knob.clone()).collect();
+    let (jobs, not_separated) = follow_up_jobs(&d.answer, &single);
+    out.not_separated = not_separated;
     // The carrying does not depend on the candidates: made once for every group.
     let carrying = match (reference, jobs.is_empty()) {
         (Some(r), false) => Some(carry_through(
@@ -1309,13 +1300,119 @@ pub fn follow_up_with(
             }
             _ => {}
         }
+        if let Verdict::Named { knob } = &verdict
+            && out.named.contains(knob)
+            && let Some(l) = separation
+                .rankings
+                .last()
+                .and_then(|r| r.summaries_left_out.clone())
+            && !out.left_out.iter().any(|(k, _)| k == knob)
+        {
+            out.left_out.push((knob.clone(), l));
+        }
         out.groups.push(FollowGroup {
             purpose,
             separation,
             verdict,
         });
     }
+    // A knob later named with a partner: the pair, not the metric left out, holds what the
+    // knob alone left (Coulomb friction alone leaves the peak torque; with the backlash
+    // beside it, nothing).
+    let paired: Vec<String> = out
+        .groups
+        .iter()
+        .filter_map(|g| match &g.verdict {
+            Verdict::NamedTogether { knobs } => Some(knobs.clone()),
+            _ => None,
+        })
+        .flatten()
+        .collect();
+    out.left_out.retain(|(k, _)| !paired.contains(k));
     Ok(out)
+}
+
+/// The groups [`follow_up_with`] separates after a diagnosis whose answer is `answer` and
+/// whose single knobs, best first, are `single`, as (why, candidates); and the groups it does
+/// not separate, with why.
+pub fn follow_up_jobs(
+    answer: &super::diagnose::Answer,
+    single: &[String],
+) -> (Vec<(FollowPurpose, Vec<String>)>, Vec<String>) {
+    let answer_names: Vec<String> = answer
+        .effects
+        .iter()
+        .chain(&answer.parameters)
+        .map(|n| n.knob.clone())
+        .collect();
+    let mut not_separated = Vec::new();
+    // A group is the summaries' look-alikes; the truth may be a knob the diagnosis did not
+    // put in it (measured on Drake-Lagged: hip Coulomb friction 0.015 N·m left the group
+    // {viscous damping, μ}, and the cycles named viscous damping from it). So each group is
+    // separated together with its best single-knob rivals outside it.
+    let with_rivals = |group: &[String]| {
+        let mut g = group.to_vec();
+        g.extend(
+            single
+                .iter()
+                .filter(|k| !group.contains(k))
+                .take(CONFIRM_RIVALS)
+                .cloned(),
+        );
+        g
+    };
+    let mut jobs: Vec<(FollowPurpose, Vec<String>)> = answer
+        .ambiguous
+        .iter()
+        .filter(|g| g.len() >= 2)
+        .map(|g| (FollowPurpose::Ambiguous, with_rivals(g)))
+        .collect();
+    let beyond_noise = matches!(
+        answer.kind,
+        AnswerKind::PartlyExplained | AnswerKind::Unexplained
+    );
+    if answer_names.is_empty() && beyond_noise {
+        let mut group: Vec<String> = answer.leads.iter().map(|n| n.knob.clone()).collect();
+        for k in single {
+            if group.len() >= EXPLORE_CANDIDATES {
+                break;
+            }
+            if !group.contains(k) {
+                group.push(k.clone());
+            }
+        }
+        if group.len() >= 2 {
+            jobs.push((FollowPurpose::Explore, group));
+        }
+    }
+    if let [knob] = answer_names.as_slice() {
+        let mut group = vec![knob.clone()];
+        group.extend(
+            single
+                .iter()
+                .filter(|k| *k != knob)
+                .take(CONFIRM_RIVALS)
+                .cloned(),
+        );
+        if group.len() >= 2 {
+            jobs.push((FollowPurpose::Confirm { knob: knob.clone() }, group));
+        }
+    }
+    // A group holding a number the design does not declare (the audit's look-alike, "…
+    // (undeclared)") is not separated: the cycles cannot fit that number, and separating the
+    // rest could name the stand-in the audit took the name from. Its knobs stay unnamed.
+    jobs.retain(|(_, group)| {
+        let Some(u) = group.iter().find(|k| k.contains(super::audit::UNDECLARED)) else {
+            return true;
+        };
+        not_separated.push(format!(
+            "{{{}}}: it holds {u}, a number the design does not declare, which the cycles \
+             cannot fit (declare it with a range to separate it)",
+            group.join(", ")
+        ));
+        false
+    });
+    (jobs, not_separated)
 }
 
 /// A verdict in a few words.
@@ -1388,8 +1485,21 @@ fn summaries_p_value(
 ) -> f64 {
     let dof = (obs.len().max(k + 1) - k) as f64;
     let p = (blocks * chi2_upper_p(chi2, dof).unwrap_or(0.0)).min(1.0);
+    one_metric_left_out(obs, sims, k, blocks, opts)
+        .map_or(p, |w| p.max((blocks * w.p_left).min(1.0)))
+}
+
+/// Through a reference: the metric without which summaries that fail the χ² test fit
+/// within noise (`reference::within_noise_but_one`, at α over the blocks); None otherwise.
+fn one_metric_left_out(
+    obs: &[Observation],
+    sims: &[SimCycle],
+    k: usize,
+    blocks: f64,
+    opts: &SeparateOptions,
+) -> Option<super::reference::WithinNoiseButOne> {
     if !opts.through_reference {
-        return p;
+        return None;
     }
     super::reference::within_noise_but_one(
         obs,
@@ -1397,7 +1507,6 @@ fn summaries_p_value(
         k,
         opts.alpha / blocks,
     )
-    .map_or(p, |w| p.max((blocks * w.p_left).min(1.0)))
 }
 
 /// χ²₁'s 95 % point: a profile's bound.
@@ -1612,4 +1721,61 @@ fn pair_profile(
         profile[j].clone()
     };
     Ok((profile, best))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::gap::diagnose::{Answer, AnswerKind};
+
+    fn ambiguous_answer(groups: Vec<Vec<&str>>) -> Answer {
+        Answer {
+            kind: AnswerKind::Ambiguous,
+            parameters: Vec::new(),
+            effects: Vec::new(),
+            leads: Vec::new(),
+            ambiguous: groups
+                .into_iter()
+                .map(|g| g.into_iter().map(String::from).collect())
+                .collect(),
+            rest: None,
+            statement: String::new(),
+        }
+    }
+
+    /// The audit's look-alike group (a declared knob with an undeclared number, which
+    /// `separate` cannot fit) is left out with why; a group of fittable knobs is separated
+    /// with its two best single rivals outside it. Before, the undeclared label was passed
+    /// on as a candidate and the whole diagnosis ended in an error (seen through a reference
+    /// with logs: a foot-centre offset of 0.015 L read as μ or the COM offset).
+    #[test]
+    fn a_look_alike_group_holding_an_undeclared_number_is_not_separated() {
+        let single: Vec<String> = ["mugatu:contact.friction_mu", "hip_backlash", "soft_ground"]
+            .map(String::from)
+            .to_vec();
+        let undeclared = format!(
+            "mugatu:geometry.foot_center_forward_over_l{}",
+            crate::gap::audit::UNDECLARED
+        );
+        let answer = ambiguous_answer(vec![
+            vec!["mugatu:mass.leg_com_forward_over_l", &undeclared],
+            vec!["hip_coulomb_friction", "hip_viscous_damping"],
+        ]);
+        let (jobs, skipped) = follow_up_jobs(&answer, &single);
+        assert_eq!(
+            jobs,
+            vec![(
+                FollowPurpose::Ambiguous,
+                vec![
+                    "hip_coulomb_friction".to_string(),
+                    "hip_viscous_damping".into(),
+                    "mugatu:contact.friction_mu".into(),
+                    "hip_backlash".into(),
+                ]
+            )]
+        );
+        assert_eq!(skipped.len(), 1, "{skipped:?}");
+        assert!(skipped[0].contains(&undeclared), "{skipped:?}");
+        assert!(skipped[0].contains("mugatu:mass.leg_com_forward_over_l"));
+    }
 }

@@ -7,7 +7,7 @@ use plotters::prelude::*;
 
 use super::plot::{PlotError, register_font};
 use super::sig;
-use crate::gap::separate::{FollowPurpose, FollowUp, Ranking, Separation, Verdict};
+use crate::gap::separate::{FollowPurpose, FollowUp, MetricLeftOut, Ranking, Separation, Verdict};
 use crate::gap::suggest::{Suggested, Suggestion};
 use crate::gap::waveform::{FIGURE_BINS, Signal};
 use crate::gap::waveform_bench::WaveformBench;
@@ -40,9 +40,39 @@ fn verdict_text(v: &Verdict) -> String {
     }
 }
 
+/// A p-value: three significant figures, in scientific notation below 0.001 (`sig` would
+/// write a hundred zeros before a p of 1e-100).
+fn p_text(p: f64) -> String {
+    if p > 0.0 && p < 1e-3 {
+        format!("{p:.2e}")
+    } else {
+        sig(p)
+    }
+}
+
+/// The caveat of a best candidate whose carried summaries fit only without one metric.
+pub(crate) fn left_out_text(l: &MetricLeftOut) -> String {
+    format!(
+        "Its carried summaries fit within noise only with {} left out (χ² {} on its {} \
+         values): what lies there is another cause outside the candidates or the engines' \
+         versions of the effect answering that metric apart, and these trials do not say which",
+        l.metric,
+        sig(l.chi2),
+        l.values
+    )
+}
+
 fn ranking_md(o: &mut String, r: &Ranking) {
     let _ = writeln!(o, "### {}\n", r.evidence.label());
     let _ = writeln!(o, "Answer: {}.\n", verdict_text(&r.verdict));
+    if let Some(l) = &r.summaries_left_out
+        && matches!(
+            r.verdict,
+            Verdict::Named { .. } | Verdict::CannotTell { .. }
+        )
+    {
+        let _ = writeln!(o, "{}.\n", left_out_text(l));
+    }
     if r.fits.is_empty() {
         return;
     }
@@ -51,7 +81,7 @@ fn ranking_md(o: &mut String, r: &Ranking) {
         "{} observations; nominal χ² {}; best χ² p = {}; over-dispersion {}.\n",
         r.observations,
         sig(r.nominal_chi2),
-        sig(r.best_p_value),
+        p_text(r.best_p_value),
         sig(r.overdispersion)
     );
     let _ = writeln!(
@@ -154,8 +184,11 @@ pub fn separation_md(s: &Separation) -> String {
 /// Empty when nothing was separated.
 pub fn follow_up_md(f: &FollowUp) -> String {
     let mut o = String::new();
-    if f.groups.is_empty() {
+    if f.groups.is_empty() && f.not_separated.is_empty() {
         return o;
+    }
+    for n in &f.not_separated {
+        let _ = writeln!(o, "\nNot separated with the logged cycles: {n}.");
     }
     for g in &f.groups {
         match &g.purpose {
@@ -190,6 +223,13 @@ pub fn follow_up_md(f: &FollowUp) -> String {
             format!(" Withdrawn: {}.", f.withdrawn.join("; "))
         }
     );
+    for (knob, l) in &f.left_out {
+        let _ = writeln!(
+            o,
+            "{knob}: {}.\n",
+            left_out_text(l).replacen("Its", "its", 1)
+        );
+    }
     o
 }
 
