@@ -145,7 +145,7 @@ pub struct Ranking {
     #[serde(skip_serializing_if = "Option::is_none")]
     pub summaries_left_out: Option<MetricLeftOut>,
     /// The best candidate with each plausible rival fitted together (summaries + waveforms
-    /// only): [`check_pairs`].
+    /// only): [`FitProblem::check_pairs`].
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub pairs: Vec<PairFit>,
 }
@@ -669,9 +669,16 @@ pub fn separate_with(
     let (nom_s, nom_w) = chi2_pair(&obs, sigs, &nominal, opts.relative_floor);
     let n_wave: usize = sigs.iter().flatten().map(coefficient_count).sum();
 
+    let problem = FitProblem {
+        walker: &walker,
+        knobs: &knobs,
+        obs: &obs,
+        sigs,
+        opts,
+    };
     let mut fits: Vec<[Best; 2]> = Vec::new();
     for &k in &idx {
-        fits.push(fit_candidate(&walker, &knobs, k, &obs, sigs, opts)?);
+        fits.push(problem.fit_candidate(k)?);
     }
     let fitted = Fitted {
         obs: &obs,
@@ -699,7 +706,7 @@ pub fn separate_with(
         .iter_mut()
         .find(|r| r.evidence == Evidence::SummariesAndWaveforms)
     {
-        check_pairs(&walker, &knobs, &obs, sigs, opts, r)?;
+        problem.check_pairs(r)?;
     }
     let cycles = fitted.cycles(set, &rankings, &nominal);
     Ok(Separation {
@@ -778,51 +785,50 @@ struct Best {
     w: f64,
 }
 
-/// Each candidate: grid, then golden section per evidence kind, all on walks. Returns the
-/// best fit on summaries and on summaries and waveforms.
-fn fit_candidate(
-    walker: &Walker,
-    knobs: &Knobs,
-    k: usize,
-    obs: &[Observation],
-    sigs: &[Option<CycleSignature>],
-    opts: &SeparateOptions,
-) -> Result<[Best; 2], GapError> {
-    let by_summary = fit_one(walker, knobs, k, obs, sigs, opts, &|s, _| s)?;
-    let by_both = fit_one(walker, knobs, k, obs, sigs, opts, &|s, w| s + w)?;
-    Ok([by_summary, by_both])
+/// What every fit on walks of a separation shares (the problem; each fit says which knobs
+/// it frees and by which cost): the walker, the knobs, the observations and measured cycles
+/// the fits are judged on, and the options.
+struct FitProblem<'a> {
+    walker: &'a Walker<'a>,
+    knobs: &'a Knobs,
+    obs: &'a [Observation],
+    sigs: &'a [Option<CycleSignature>],
+    opts: &'a SeparateOptions,
 }
 
-/// One knob alone (the rest at the file's values) fitted by `cost(summaries χ², cycles χ²)`:
-/// its grid, then a golden section between the best node's neighbours, on walks (the grid's
-/// walks are shared through the cache by every cost).
-#[allow(clippy::too_many_arguments)]
-fn fit_one(
-    walker: &Walker,
-    knobs: &Knobs,
-    k: usize,
-    obs: &[Observation],
-    sigs: &[Option<CycleSignature>],
-    opts: &SeparateOptions,
-    cost: &dyn Fn(f64, f64) -> f64,
-) -> Result<Best, GapError> {
-    let knob = &knobs.list[k];
-    let label = knob.label();
-    let eval = |x: f64| -> Result<Best, GapError> {
-        let mut point = knobs.nominal_point();
-        point[k] = Some(x);
-        let sims = walker.run(
-            (label.clone(), x.to_bits()),
-            &knobs.setting(walker.lib, &point),
-        )?;
-        let (s, w) = chi2_pair(obs, sigs, &sims, opts.relative_floor);
-        Ok(Best { x, sims, s, w })
-    };
-    grid_then_golden(
-        &knob.nodes(opts.grid_points),
-        opts.refine_steps.saturating_sub(1),
-        |x| eval(x).map(|q| (cost(q.s, q.w), q)),
-    )
+impl FitProblem<'_> {
+    /// Each candidate: grid, then golden section per evidence kind, all on walks. Returns the
+    /// best fit on summaries and on summaries and waveforms.
+    fn fit_candidate(&self, k: usize) -> Result<[Best; 2], GapError> {
+        let by_summary = self.fit_one(k, &|s, _| s)?;
+        let by_both = self.fit_one(k, &|s, w| s + w)?;
+        Ok([by_summary, by_both])
+    }
+
+    /// One knob alone (the rest at the file's values) fitted by `cost(summaries χ², cycles χ²)`:
+    /// its grid, then a golden section between the best node's neighbours, on walks (the grid's
+    /// walks are shared through the cache by every cost).
+    fn fit_one(&self, k: usize, cost: &dyn Fn(f64, f64) -> f64) -> Result<Best, GapError> {
+        let (walker, knobs, obs, sigs, opts) =
+            (self.walker, self.knobs, self.obs, self.sigs, self.opts);
+        let knob = &knobs.list[k];
+        let label = knob.label();
+        let eval = |x: f64| -> Result<Best, GapError> {
+            let mut point = knobs.nominal_point();
+            point[k] = Some(x);
+            let sims = walker.run(
+                (label.clone(), x.to_bits()),
+                &knobs.setting(walker.lib, &point),
+            )?;
+            let (s, w) = chi2_pair(obs, sigs, &sims, opts.relative_floor);
+            Ok(Best { x, sims, s, w })
+        };
+        grid_then_golden(
+            &knob.nodes(opts.grid_points),
+            opts.refine_steps.saturating_sub(1),
+            |x| eval(x).map(|q| (cost(q.s, q.w), q)),
+        )
+    }
 }
 
 /// A 1-D fit on walks: the grid `nodes`, then a golden section of `reductions` steps between
@@ -1512,140 +1518,136 @@ fn one_metric_left_out(
 /// χ²₁'s 95 % point: a profile's bound.
 const CHI2_1_95: f64 = 3.841_458_820_694_124;
 
-/// The best candidate of the summaries + waveforms ranking fitted together with each rival
-/// ([`pair_profile`]); a pair is named ([`Verdict::NamedTogether`]) when it is the only one
-/// that passes every rule:
-/// * each knob is needed beside the other: the pair beats each knob alone by the
-///   likelihood-ratio test (1 dof, Δχ² over the ranking's over-dispersion) at α over the
-///   pairs tried;
-/// * neither value sits at an end of its range;
-/// * it fits within noise in both blocks of evidence (Bonferroni over them; the summaries
-///   by the ranking's rule, which through a reference forgives one metric).
-///
-/// The evidence is the ranking's: summaries + cycles χ², or through a reference the cycles'
-/// χ² alone (the summaries only judge plausibility there: which look-alike carried
-/// summaries favour is the engines' business). Measured on Drake-Lagged through its
-/// no-effect trials, noise-free: viscous damping 0.02 N·m·s/rad with Coulomb friction 0.05
-/// N·m fit the cycles at χ² 11.4 as a pair against 29.1 for damping alone (on 372
-/// coefficients), while Coulomb friction 0.065 N·m alone gains 0.4 from a damping beside
-/// it and damping 0.025 alone nothing from Coulomb friction; on the summaries + cycles the
-/// same Coulomb friction would have gained 12.5 from a spurious damping (the summaries'
-/// engine difference), hence the cycles alone.
-///
-/// Where no pair passes, each pair still says how much of the second knob the profile does
-/// not reject beside the first (`PairFit::second_upper`): a single name is then "this, with
-/// up to so much of that".
-fn check_pairs(
-    walker: &Walker,
-    knobs: &Knobs,
-    obs: &[Observation],
-    sigs: &[Option<CycleSignature>],
-    opts: &SeparateOptions,
-    r: &mut Ranking,
-) -> Result<(), GapError> {
-    let judged = matches!(
-        r.verdict,
-        Verdict::Named { .. } | Verdict::CannotTell { .. } | Verdict::NoneFits { .. }
-    );
-    if !judged || r.fits.len() < 2 {
-        return Ok(());
-    }
-    let n_wave: usize = sigs.iter().flatten().map(coefficient_count).sum();
-    let cycles_decide = opts.through_reference && n_wave > 0;
-    let cost: &dyn Fn(f64, f64) -> f64 = if cycles_decide {
-        &|_, w| w
-    } else {
-        &|s, w| s + w
-    };
-    let blocks = if n_wave > 0 { 2.0 } else { 1.0 };
-    let Some(a) = knobs.index_of(&r.fits[0].knob) else {
-        return Ok(());
-    };
-    let rivals: Vec<usize> = r.fits[1..]
-        .iter()
-        .filter_map(|f| knobs.index_of(&f.knob))
-        .collect();
-    let per_test = opts.alpha / rivals.len().max(1) as f64;
-    let needed = |d: f64| chi2_upper_p(d.max(0.0), 1.0).unwrap_or(1.0) < per_test;
-    let phi = r.overdispersion.max(1.0);
-    let alone_a = fit_one(walker, knobs, a, obs, sigs, opts, cost)?;
-    let (ka, wave_dof) = (&knobs.list[a], (n_wave.max(3) - 2) as f64);
-    let at_end = |k: &super::knob::Knob, x: f64| {
-        let span = k.hi - k.lo;
-        (x - k.lo).abs() < 1e-3 * span || (k.hi - x).abs() < 1e-3 * span
-    };
-    let mut pairs = Vec::with_capacity(rivals.len());
-    for b in rivals {
-        let kb = &knobs.list[b];
-        let alone_b = fit_one(walker, knobs, b, obs, sigs, opts, cost)?;
-        let (profile, best) = pair_profile(walker, knobs, a, b, obs, sigs, opts, cost)?;
-        let c = cost(best.s, best.w);
-        let delta = [
-            (cost(alone_a.s, alone_a.w) - c) / phi,
-            (cost(alone_b.s, alone_b.w) - c) / phi,
-        ];
-        let p_summaries = summaries_p_value(obs, &best.sims, best.s, 2, blocks, opts);
-        let p_cycles = if n_wave > 0 {
-            (blocks * chi2_upper_p(best.w, wave_dof).unwrap_or(0.0)).min(1.0)
+impl FitProblem<'_> {
+    /// The best candidate of the summaries + waveforms ranking fitted together with each rival
+    /// ([`Self::pair_profile`]); a pair is named ([`Verdict::NamedTogether`]) when it is the only one
+    /// that passes every rule:
+    /// * each knob is needed beside the other: the pair beats each knob alone by the
+    ///   likelihood-ratio test (1 dof, Δχ² over the ranking's over-dispersion) at α over the
+    ///   pairs tried;
+    /// * neither value sits at an end of its range;
+    /// * it fits within noise in both blocks of evidence (Bonferroni over them; the summaries
+    ///   by the ranking's rule, which through a reference forgives one metric).
+    ///
+    /// The evidence is the ranking's: summaries + cycles χ², or through a reference the cycles'
+    /// χ² alone (the summaries only judge plausibility there: which look-alike carried
+    /// summaries favour is the engines' business). Measured on Drake-Lagged through its
+    /// no-effect trials, noise-free: viscous damping 0.02 N·m·s/rad with Coulomb friction 0.05
+    /// N·m fit the cycles at χ² 11.4 as a pair against 29.1 for damping alone (on 372
+    /// coefficients), while Coulomb friction 0.065 N·m alone gains 0.4 from a damping beside
+    /// it and damping 0.025 alone nothing from Coulomb friction; on the summaries + cycles the
+    /// same Coulomb friction would have gained 12.5 from a spurious damping (the summaries'
+    /// engine difference), hence the cycles alone.
+    ///
+    /// Where no pair passes, each pair still says how much of the second knob the profile does
+    /// not reject beside the first (`PairFit::second_upper`): a single name is then "this, with
+    /// up to so much of that".
+    fn check_pairs(&self, r: &mut Ranking) -> Result<(), GapError> {
+        let (knobs, obs, sigs, opts) = (self.knobs, self.obs, self.sigs, self.opts);
+        let judged = matches!(
+            r.verdict,
+            Verdict::Named { .. } | Verdict::CannotTell { .. } | Verdict::NoneFits { .. }
+        );
+        if !judged || r.fits.len() < 2 {
+            return Ok(());
+        }
+        let n_wave: usize = sigs.iter().flatten().map(coefficient_count).sum();
+        let cycles_decide = opts.through_reference && n_wave > 0;
+        let cost: &dyn Fn(f64, f64) -> f64 = if cycles_decide {
+            &|_, w| w
         } else {
-            1.0
+            &|s, w| s + w
         };
-        let why_not = if !needed(delta[0]) {
-            Some(format!(
-                "{} is not needed beside {} (Δ {:.1})",
-                kb.label(),
-                ka.label(),
-                delta[0]
-            ))
-        } else if !needed(delta[1]) {
-            Some(format!(
-                "{} is not needed beside {} (Δ {:.1})",
-                ka.label(),
-                kb.label(),
-                delta[1]
-            ))
-        } else if at_end(ka, best.xa) || at_end(kb, best.xb) {
-            Some("a value at an end of its range".to_string())
-        } else if p_summaries < opts.alpha || p_cycles < opts.alpha {
-            Some(format!(
-                "it does not fit within noise (p {:.2e} on the summaries, {:.2e} on the cycles)",
-                p_summaries, p_cycles
-            ))
-        } else {
-            None
+        let blocks = if n_wave > 0 { 2.0 } else { 1.0 };
+        let Some(a) = knobs.index_of(&r.fits[0].knob) else {
+            return Ok(());
         };
-        // The profile's 95 % range of the second knob, at the grid's resolution: from the
-        // node below the first one the profile does not reject to the node above the last.
-        let floor = profile.iter().map(|q| cost(q.s, q.w)).fold(c, f64::min);
-        let kept = |q: &PairPoint| cost(q.s, q.w) <= floor + CHI2_1_95 * phi;
-        let first = profile.iter().position(kept).unwrap_or(0);
-        let last = profile.iter().rposition(kept).unwrap_or(profile.len() - 1);
-        let ends = [
-            profile[first.saturating_sub(1)].xb,
-            profile[(last + 1).min(profile.len() - 1)].xb,
-        ];
-        let (lo, hi) = (kb.si(ends[0]), kb.si(ends[1]));
-        let second_range = [lo.min(hi), lo.max(hi)];
-        pairs.push(PairFit {
-            knobs: [ka.label(), kb.label()],
-            values: [ka.si(best.xa), kb.si(best.xb)],
-            units: [ka.unit.clone(), kb.unit.clone()],
-            chi2_summaries: best.s,
-            chi2_waveforms: best.w,
-            delta,
-            second_range,
-            passes: why_not.is_none(),
-            why_not,
-        });
+        let rivals: Vec<usize> = r.fits[1..]
+            .iter()
+            .filter_map(|f| knobs.index_of(&f.knob))
+            .collect();
+        let per_test = opts.alpha / rivals.len().max(1) as f64;
+        let needed = |d: f64| chi2_upper_p(d.max(0.0), 1.0).unwrap_or(1.0) < per_test;
+        let phi = r.overdispersion.max(1.0);
+        let alone_a = self.fit_one(a, cost)?;
+        let (ka, wave_dof) = (&knobs.list[a], (n_wave.max(3) - 2) as f64);
+        let at_end = |k: &super::knob::Knob, x: f64| {
+            let span = k.hi - k.lo;
+            (x - k.lo).abs() < 1e-3 * span || (k.hi - x).abs() < 1e-3 * span
+        };
+        let mut pairs = Vec::with_capacity(rivals.len());
+        for b in rivals {
+            let kb = &knobs.list[b];
+            let alone_b = self.fit_one(b, cost)?;
+            let (profile, best) = self.pair_profile(a, b, cost)?;
+            let c = cost(best.s, best.w);
+            let delta = [
+                (cost(alone_a.s, alone_a.w) - c) / phi,
+                (cost(alone_b.s, alone_b.w) - c) / phi,
+            ];
+            let p_summaries = summaries_p_value(obs, &best.sims, best.s, 2, blocks, opts);
+            let p_cycles = if n_wave > 0 {
+                (blocks * chi2_upper_p(best.w, wave_dof).unwrap_or(0.0)).min(1.0)
+            } else {
+                1.0
+            };
+            let why_not = if !needed(delta[0]) {
+                Some(format!(
+                    "{} is not needed beside {} (Δ {:.1})",
+                    kb.label(),
+                    ka.label(),
+                    delta[0]
+                ))
+            } else if !needed(delta[1]) {
+                Some(format!(
+                    "{} is not needed beside {} (Δ {:.1})",
+                    ka.label(),
+                    kb.label(),
+                    delta[1]
+                ))
+            } else if at_end(ka, best.xa) || at_end(kb, best.xb) {
+                Some("a value at an end of its range".to_string())
+            } else if p_summaries < opts.alpha || p_cycles < opts.alpha {
+                Some(format!(
+                    "it does not fit within noise (p {:.2e} on the summaries, {:.2e} on the cycles)",
+                    p_summaries, p_cycles
+                ))
+            } else {
+                None
+            };
+            // The profile's 95 % range of the second knob, at the grid's resolution: from the
+            // node below the first one the profile does not reject to the node above the last.
+            let floor = profile.iter().map(|q| cost(q.s, q.w)).fold(c, f64::min);
+            let kept = |q: &PairPoint| cost(q.s, q.w) <= floor + CHI2_1_95 * phi;
+            let first = profile.iter().position(kept).unwrap_or(0);
+            let last = profile.iter().rposition(kept).unwrap_or(profile.len() - 1);
+            let ends = [
+                profile[first.saturating_sub(1)].xb,
+                profile[(last + 1).min(profile.len() - 1)].xb,
+            ];
+            let (lo, hi) = (kb.si(ends[0]), kb.si(ends[1]));
+            let second_range = [lo.min(hi), lo.max(hi)];
+            pairs.push(PairFit {
+                knobs: [ka.label(), kb.label()],
+                values: [ka.si(best.xa), kb.si(best.xb)],
+                units: [ka.unit.clone(), kb.unit.clone()],
+                chi2_summaries: best.s,
+                chi2_waveforms: best.w,
+                delta,
+                second_range,
+                passes: why_not.is_none(),
+                why_not,
+            });
+        }
+        let passing: Vec<&PairFit> = pairs.iter().filter(|p| p.passes).collect();
+        if let [p] = passing.as_slice() {
+            r.verdict = Verdict::NamedTogether {
+                knobs: p.knobs.to_vec(),
+            };
+        }
+        r.pairs = pairs;
+        Ok(())
     }
-    let passing: Vec<&PairFit> = pairs.iter().filter(|p| p.passes).collect();
-    if let [p] = passing.as_slice() {
-        r.verdict = Verdict::NamedTogether {
-            knobs: p.knobs.to_vec(),
-        };
-    }
-    r.pairs = pairs;
-    Ok(())
 }
 
 /// One point of a pair's profile: knob `b` held at `xb`, knob `a` refitted on walks.
@@ -1658,69 +1660,69 @@ struct PairPoint {
     w: f64,
 }
 
-/// The profile of knob `b` beside knob `a` (both free, the rest at the file's values): at
-/// each of `b`'s grid nodes, `a` fitted by its grid and a golden section on walks, by
-/// `cost(summaries χ², cycles χ²)`; then `b` refined by a golden section between the best
-/// node's neighbours, `a` refitted inside the bracket its neighbours' fits span. Returns the
-/// nodes' fits (in `b`'s order) and the refined best.
-#[allow(clippy::too_many_arguments)]
-fn pair_profile(
-    walker: &Walker,
-    knobs: &Knobs,
-    a: usize,
-    b: usize,
-    obs: &[Observation],
-    sigs: &[Option<CycleSignature>],
-    opts: &SeparateOptions,
-    cost: &dyn Fn(f64, f64) -> f64,
-) -> Result<(Vec<PairPoint>, PairPoint), GapError> {
-    let (ka, kb) = (&knobs.list[a], &knobs.list[b]);
-    let label = format!("{}|{}", ka.label(), kb.label());
-    let eval = |xa: f64, xb: f64| -> Result<PairPoint, GapError> {
-        let mut point = knobs.nominal_point();
-        point[a] = Some(xa);
-        point[b] = Some(xb);
-        let sims = walker.run(
-            (format!("{label}={:x}", xb.to_bits()), xa.to_bits()),
-            &knobs.setting(walker.lib, &point),
-        )?;
-        let (s, w) = chi2_pair(obs, sigs, &sims, opts.relative_floor);
-        Ok(PairPoint { xa, xb, sims, s, w })
-    };
-    let steps = opts.refine_steps.saturating_sub(1);
-    let by_cost = |q: PairPoint| (cost(q.s, q.w), q);
-    // `a` fitted with `b` at `xb`: over `a`'s whole range, or by a golden section in [lo, hi].
-    let fit_a = |xb: f64| {
-        grid_then_golden(&ka.nodes(opts.grid_points), steps, |x| {
-            eval(x, xb).map(by_cost)
-        })
-    };
-    let fit_a_in = |xb: f64, lo: f64, hi: f64| {
-        super::solver::golden_section(lo, hi, steps, |x| eval(x, xb).map(by_cost)).map(|r| r.2)
-    };
-    let nodes_b = kb.nodes(opts.grid_points);
-    let mut profile = Vec::with_capacity(nodes_b.len());
-    for &xb in &nodes_b {
-        profile.push(fit_a(xb)?);
+impl FitProblem<'_> {
+    /// The profile of knob `b` beside knob `a` (both free, the rest at the file's values): at
+    /// each of `b`'s grid nodes, `a` fitted by its grid and a golden section on walks, by
+    /// `cost(summaries χ², cycles χ²)`; then `b` refined by a golden section between the best
+    /// node's neighbours, `a` refitted inside the bracket its neighbours' fits span. Returns the
+    /// nodes' fits (in `b`'s order) and the refined best.
+    fn pair_profile(
+        &self,
+        a: usize,
+        b: usize,
+        cost: &dyn Fn(f64, f64) -> f64,
+    ) -> Result<(Vec<PairPoint>, PairPoint), GapError> {
+        let (walker, knobs, obs, sigs, opts) =
+            (self.walker, self.knobs, self.obs, self.sigs, self.opts);
+        let (ka, kb) = (&knobs.list[a], &knobs.list[b]);
+        let label = format!("{}|{}", ka.label(), kb.label());
+        let eval = |xa: f64, xb: f64| -> Result<PairPoint, GapError> {
+            let mut point = knobs.nominal_point();
+            point[a] = Some(xa);
+            point[b] = Some(xb);
+            let sims = walker.run(
+                (format!("{label}={:x}", xb.to_bits()), xa.to_bits()),
+                &knobs.setting(walker.lib, &point),
+            )?;
+            let (s, w) = chi2_pair(obs, sigs, &sims, opts.relative_floor);
+            Ok(PairPoint { xa, xb, sims, s, w })
+        };
+        let steps = opts.refine_steps.saturating_sub(1);
+        let by_cost = |q: PairPoint| (cost(q.s, q.w), q);
+        // `a` fitted with `b` at `xb`: over `a`'s whole range, or by a golden section in [lo, hi].
+        let fit_a = |xb: f64| {
+            grid_then_golden(&ka.nodes(opts.grid_points), steps, |x| {
+                eval(x, xb).map(by_cost)
+            })
+        };
+        let fit_a_in = |xb: f64, lo: f64, hi: f64| {
+            super::solver::golden_section(lo, hi, steps, |x| eval(x, xb).map(by_cost)).map(|r| r.2)
+        };
+        let nodes_b = kb.nodes(opts.grid_points);
+        let mut profile = Vec::with_capacity(nodes_b.len());
+        for &xb in &nodes_b {
+            profile.push(fit_a(xb)?);
+        }
+        let j = (0..profile.len())
+            .min_by(|x, y| {
+                cost(profile[*x].s, profile[*x].w).total_cmp(&cost(profile[*y].s, profile[*y].w))
+            })
+            .unwrap_or(0);
+        let (jl, jh) = (j.saturating_sub(1), (j + 1).min(profile.len() - 1));
+        let step_a = (ka.hi - ka.lo) / (opts.grid_points.max(2) - 1) as f64;
+        let a_lo = (profile[jl].xa.min(profile[jh].xa) - step_a).max(ka.lo);
+        let a_hi = (profile[jl].xa.max(profile[jh].xa) + step_a).min(ka.hi);
+        let (_, c, refined) =
+            super::solver::golden_section(nodes_b[jl], nodes_b[jh], steps, |xb| {
+                fit_a_in(xb, a_lo, a_hi).map(by_cost)
+            })?;
+        let best = if c < cost(profile[j].s, profile[j].w) {
+            refined
+        } else {
+            profile[j].clone()
+        };
+        Ok((profile, best))
     }
-    let j = (0..profile.len())
-        .min_by(|x, y| {
-            cost(profile[*x].s, profile[*x].w).total_cmp(&cost(profile[*y].s, profile[*y].w))
-        })
-        .unwrap_or(0);
-    let (jl, jh) = (j.saturating_sub(1), (j + 1).min(profile.len() - 1));
-    let step_a = (ka.hi - ka.lo) / (opts.grid_points.max(2) - 1) as f64;
-    let a_lo = (profile[jl].xa.min(profile[jh].xa) - step_a).max(ka.lo);
-    let a_hi = (profile[jl].xa.max(profile[jh].xa) + step_a).min(ka.hi);
-    let (_, c, refined) = super::solver::golden_section(nodes_b[jl], nodes_b[jh], steps, |xb| {
-        fit_a_in(xb, a_lo, a_hi).map(by_cost)
-    })?;
-    let best = if c < cost(profile[j].s, profile[j].w) {
-        refined
-    } else {
-        profile[j].clone()
-    };
-    Ok((profile, best))
 }
 
 #[cfg(test)]
