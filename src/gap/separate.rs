@@ -182,6 +182,10 @@ pub struct PairFit {
     /// Why not, when it does not pass.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub why_not: Option<String>,
+    /// Through a reference: the one metric without which the pair's carried summaries fit
+    /// within noise, where they do not with it (as [`Ranking::summaries_left_out`]).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub summaries_left_out: Option<MetricLeftOut>,
 }
 
 /// Cycles of one trial for the figure: measured, nominal and best candidate (waveform mode).
@@ -1316,6 +1320,21 @@ pub fn follow_up_with(
         {
             out.left_out.push((knob.clone(), l));
         }
+        // A named pair whose carried summaries fit only without one metric: under the pair's
+        // label ("a + b"), which the paired knobs' own caveats give way to below.
+        if let Verdict::NamedTogether { knobs } = &verdict
+            && knobs.iter().all(|k| out.named.contains(k))
+            && let Some(l) = separation
+                .rankings
+                .last()
+                .and_then(|r| r.pairs.iter().find(|p| p.passes))
+                .and_then(|p| p.summaries_left_out.clone())
+        {
+            let label = knobs.join(" + ");
+            if !out.left_out.iter().any(|(k, _)| *k == label) {
+                out.left_out.push((label, l));
+            }
+        }
         out.groups.push(FollowGroup {
             purpose,
             separation,
@@ -1637,6 +1656,15 @@ impl FitProblem<'_> {
                 second_range,
                 passes: why_not.is_none(),
                 why_not,
+                summaries_left_out: if cycles_decide {
+                    one_metric_left_out(obs, &best.sims, 2, blocks, opts).map(|w| MetricLeftOut {
+                        metric: w.metric.column().to_string(),
+                        chi2: w.chi2_metric,
+                        values: obs.len() - w.n_left,
+                    })
+                } else {
+                    None
+                },
             });
         }
         let passing: Vec<&PairFit> = pairs.iter().filter(|p| p.passes).collect();

@@ -154,6 +154,17 @@ fn ranking_md(o: &mut String, r: &Ranking) {
         );
     }
     o.push('\n');
+    if let Some(p) = r.pairs.iter().find(|p| p.passes)
+        && let Some(l) = &p.summaries_left_out
+    {
+        let _ = writeln!(
+            o,
+            "{} + {}: {}.\n",
+            p.knobs[0],
+            p.knobs[1],
+            left_out_text(l).replacen("Its", "its", 1)
+        );
+    }
 }
 
 /// The separation as Markdown.
