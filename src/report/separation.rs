@@ -23,7 +23,7 @@ fn verdict_text(v: &Verdict) -> String {
         }
         Verdict::NamedTogether { knobs } => format!(
             "**{}** together: the pair fits within noise, each is needed beside the other, and \
-             no other pair passes",
+             every other pair that passes as much fits worse beyond the test",
             knobs.join(" + ")
         ),
         Verdict::CannotTell { group } => format!(
