@@ -40,20 +40,11 @@ fn verdict_text(v: &Verdict) -> String {
     }
 }
 
-/// A p-value: three significant figures, in scientific notation below 0.001 (`sig` would
-/// write a hundred zeros before a p of 1e-100).
-fn p_text(p: f64) -> String {
-    if p > 0.0 && p < 1e-3 {
-        format!("{p:.2e}")
-    } else {
-        sig(p)
-    }
-}
-
-/// The caveat of a best candidate whose carried summaries fit only without one metric.
-pub(crate) fn left_out_text(l: &MetricLeftOut) -> String {
+/// The caveat of a name (`whose`: "Its", "knob: its") whose carried summaries fit only
+/// without one metric.
+fn left_out_text(whose: &str, l: &MetricLeftOut) -> String {
     format!(
-        "Its carried summaries fit within noise only with {} left out (χ² {} on its {} \
+        "{whose} carried summaries fit within noise only with {} left out (χ² {} on its {} \
          values): what lies there is another cause outside the candidates or the engines' \
          versions of the effect answering that metric apart, and these trials do not say which",
         l.metric,
@@ -71,17 +62,17 @@ fn ranking_md(o: &mut String, r: &Ranking) {
             Verdict::Named { .. } | Verdict::CannotTell { .. }
         )
     {
-        let _ = writeln!(o, "{}.\n", left_out_text(l));
+        let _ = writeln!(o, "{}.\n", left_out_text("Its", l));
     }
     if r.fits.is_empty() {
         return;
     }
     let _ = writeln!(
         o,
-        "{} observations; nominal χ² {}; best χ² p = {}; over-dispersion {}.\n",
+        "{} observations; nominal χ² {}; best χ² p = {:.2e}; over-dispersion {}.\n",
         r.observations,
         sig(r.nominal_chi2),
-        p_text(r.best_p_value),
+        r.best_p_value,
         sig(r.overdispersion)
     );
     let _ = writeln!(
@@ -157,13 +148,8 @@ fn ranking_md(o: &mut String, r: &Ranking) {
     if let Some(p) = r.pairs.iter().find(|p| p.passes)
         && let Some(l) = &p.summaries_left_out
     {
-        let _ = writeln!(
-            o,
-            "{} + {}: {}.\n",
-            p.knobs[0],
-            p.knobs[1],
-            left_out_text(l).replacen("Its", "its", 1)
-        );
+        let whose = format!("{} + {}: its", p.knobs[0], p.knobs[1]);
+        let _ = writeln!(o, "{}.\n", left_out_text(&whose, l));
     }
 }
 
@@ -235,11 +221,7 @@ pub fn follow_up_md(f: &FollowUp) -> String {
         }
     );
     for (knob, l) in &f.left_out {
-        let _ = writeln!(
-            o,
-            "{knob}: {}.\n",
-            left_out_text(l).replacen("Its", "its", 1)
-        );
+        let _ = writeln!(o, "{}.\n", left_out_text(&format!("{knob}: its"), l));
     }
     o
 }

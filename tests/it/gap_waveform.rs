@@ -22,6 +22,11 @@ fn scratch() -> tempfile::TempDir {
 /// `survey gap synth` on the six conditions with logs and the effects `truth`
 /// (NAME=VALUE); returns the trials path.
 fn synth(dir: &Path, name: &str, truth: &[&str], seed: u64) -> String {
+    synth_robot(dir, name, truth, &[], seed)
+}
+
+/// [`synth`] of a robot that differs from its design file at `set` (PATH=VALUE each).
+fn synth_robot(dir: &Path, name: &str, truth: &[&str], set: &[&str], seed: u64) -> String {
     let out = dir.join(format!("{name}.csv"));
     let logs = dir.join(format!("{name}-logs"));
     let cond = dir.join("conditions-6.csv");
@@ -43,6 +48,10 @@ fn synth(dir: &Path, name: &str, truth: &[&str], seed: u64) -> String {
     for t in truth {
         args.push("--effect");
         args.push(t);
+    }
+    for p in set {
+        args.push("--set");
+        args.push(p);
     }
     let o = survey(&args);
     assert!(o.status.success(), "{}", stderr(&o));
@@ -97,6 +106,32 @@ fn separate(trials: &str, candidates: &str) -> Vec<(String, String, serde_json::
             )
         })
         .collect()
+}
+
+/// The rankings of `survey gap separate --format json` (default grid), through `reference`
+/// when given.
+fn separate_rankings(
+    trials: &str,
+    candidates: &str,
+    reference: Option<&str>,
+) -> Vec<serde_json::Value> {
+    let mut args = vec![
+        "gap",
+        "separate",
+        "--trials",
+        trials,
+        "--candidates",
+        candidates,
+        "--format",
+        "json",
+    ];
+    if let Some(r) = reference {
+        args.extend_from_slice(&["--reference", r]);
+    }
+    let o = survey(&args);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let v: serde_json::Value = serde_json::from_str(&stdout(&o)).expect("json");
+    v["rankings"].as_array().expect("rankings").clone()
 }
 
 /// Hip Coulomb friction of 0.009 N·m (below the summaries' identification distance from
@@ -710,54 +745,29 @@ fn separate_through_a_reference_the_model_does_not_walk_like_is_not_comparable()
 #[test]
 fn the_cycles_through_a_reference_name_the_hip_loss_where_the_model_misses_the_robot() {
     let dir = scratch();
-    let synth_mu = |name: &str, effect: Option<&str>, seed: &str| {
-        let out = dir.path().join(format!("{name}.csv"));
-        let logs = dir.path().join(format!("{name}-logs"));
-        let cond = dir.path().join("conditions-6.csv");
-        let mut args = vec![
-            "gap",
-            "synth",
-            "--conditions",
-            cond.to_str().expect("utf-8"),
-            "--set",
-            "contact.friction_mu=0.5",
-            "--noise",
-            "0.03",
-            "--seed",
-            seed,
-            "--out",
-            out.to_str().expect("utf-8"),
-            "--logs",
-            logs.to_str().expect("utf-8"),
-        ];
-        if let Some(e) = effect {
-            args.extend_from_slice(&["--effect", e]);
-        }
-        let o = survey(&args);
-        assert!(o.status.success(), "{}", stderr(&o));
-        out.to_str().expect("utf-8").to_string()
-    };
-    let reference = synth_mu("reference", None, "11");
+    let reference = synth_robot(
+        dir.path(),
+        "reference",
+        &[],
+        &["contact.friction_mu=0.5"],
+        11,
+    );
     for (effect, truth) in [
         ("hip_coulomb_friction=0.02", "hip_coulomb_friction"),
         ("hip_viscous_damping=0.006", "hip_viscous_damping"),
     ] {
-        let trials = synth_mu(truth, Some(effect), "12");
-        let o = survey(&[
-            "gap",
-            "separate",
-            "--trials",
+        let trials = synth_robot(
+            dir.path(),
+            truth,
+            &[effect],
+            &["contact.friction_mu=0.5"],
+            12,
+        );
+        let r = separate_rankings(
             &trials,
-            "--reference",
-            &reference,
-            "--candidates",
             "hip_viscous_damping,hip_coulomb_friction",
-            "--format",
-            "json",
-        ]);
-        assert!(o.status.success(), "{}", stderr(&o));
-        let v: serde_json::Value = serde_json::from_str(&stdout(&o)).expect("json");
-        let r = v["rankings"].as_array().expect("rankings");
+            Some(&reference),
+        );
         assert_eq!(r[0]["verdict"]["kind"], "cannot_tell", "{effect}: {}", r[0]);
         assert_eq!(r[1]["verdict"]["kind"], "named", "{effect}: {}", r[1]);
         assert_eq!(r[1]["verdict"]["knob"], truth);
@@ -778,22 +788,12 @@ fn the_cycles_through_a_reference_name_the_hip_loss_where_the_model_misses_the_r
 fn through_a_reference_a_change_outside_the_candidates_is_a_gap_left_in_its_metric() {
     let dir = scratch();
     let reference = synth(dir.path(), "reference", &[], 11);
-    let run = |trials: &str| -> Vec<serde_json::Value> {
-        let o = survey(&[
-            "gap",
-            "separate",
-            "--trials",
+    let run = |trials: &str| {
+        separate_rankings(
             trials,
-            "--reference",
-            &reference,
-            "--candidates",
             "hip_viscous_damping,hip_coulomb_friction",
-            "--format",
-            "json",
-        ]);
-        assert!(o.status.success(), "{}", stderr(&o));
-        let v: serde_json::Value = serde_json::from_str(&stdout(&o)).expect("json");
-        v["rankings"].as_array().expect("rankings").clone()
+            Some(&reference),
+        )
     };
     let latency = synth(dir.path(), "latency", &["actuation_latency=0.004"], 12);
     for r in run(&latency) {
@@ -831,48 +831,15 @@ fn through_a_reference_a_change_outside_the_candidates_is_a_gap_left_in_its_metr
 fn of_two_passing_pairs_the_one_the_cycles_prefer_beyond_the_test_is_named() {
     let dir = scratch();
     let trials = |name: &str, set: &str| {
-        let out = dir.path().join(format!("{name}.csv"));
-        let logs = dir.path().join(format!("{name}-logs"));
-        let cond = dir.path().join("conditions-6.csv");
-        let o = survey(&[
-            "gap",
-            "synth",
-            "--conditions",
-            cond.to_str().expect("utf-8"),
-            "--effect",
-            "hip_coulomb_friction=0.02",
-            "--set",
-            set,
-            "--noise",
-            "0.03",
-            "--seed",
-            "12",
-            "--out",
-            out.to_str().expect("utf-8"),
-            "--logs",
-            logs.to_str().expect("utf-8"),
-        ]);
-        assert!(o.status.success(), "{}", stderr(&o));
-        out.to_str().expect("utf-8").to_string()
+        synth_robot(dir.path(), name, &["hip_coulomb_friction=0.02"], &[set], 12)
     };
     let width = "mugatu-two-uncertain:geometry.hip_half_width_over_l";
     let slope = "mugatu-two-uncertain:ground.slope_deg";
     let wide = trials("wide", "geometry.hip_half_width_over_l=0.23");
     let sloped = trials("sloped", "ground.slope_deg=1.5");
-    let cycles = |trials: &str, parameter: &str| -> serde_json::Value {
-        let o = survey(&[
-            "gap",
-            "separate",
-            "--trials",
-            trials,
-            "--candidates",
-            &format!("hip_coulomb_friction,hip_viscous_damping,{parameter}"),
-            "--format",
-            "json",
-        ]);
-        assert!(o.status.success(), "{}", stderr(&o));
-        let v: serde_json::Value = serde_json::from_str(&stdout(&o)).expect("json");
-        v["rankings"][1].clone()
+    let cycles = |trials: &str, parameter: &str| {
+        let candidates = format!("hip_coulomb_friction,hip_viscous_damping,{parameter}");
+        separate_rankings(trials, &candidates, None)[1].clone()
     };
     for (trials, parameter, truth) in [(&wide, width, 0.23), (&sloped, slope, 1.5)] {
         let r = cycles(trials, parameter);
