@@ -346,6 +346,13 @@ impl<'a> FitContext<'a> {
         self.surrogate_fit(active, point, unit, &fit.correction)
     }
 
+    /// `fit`, or `nested` refined with walks if that fits better: for a model that nests
+    /// `nested` (a point of it, `embed`ded), whose own search need not reach that point.
+    pub fn better_of(&self, fit: Fit, nested: &Fit) -> Result<Fit, GapError> {
+        let other = self.refine(nested)?;
+        Ok(if other.chi2 < fit.chi2 { other } else { fit })
+    }
+
     /// The surrogate fit from starts judged with `base`'s correction (screening, no walks).
     pub fn screen(&self, active: &[usize], starts: &[(Point, Correction)], base: &Fit) -> Fit {
         let points: Vec<Point> = starts.iter().map(|(p, _)| p.clone()).collect();
