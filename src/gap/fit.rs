@@ -346,10 +346,20 @@ impl<'a> FitContext<'a> {
         self.surrogate_fit(active, point, unit, &fit.correction)
     }
 
-    /// `fit`, or `nested` refined with walks if that fits better: for a model that nests
+    /// `fit`, or the point of `nested` walked if that fits better: for a model that nests
     /// `nested` (a point of it, `embed`ded), whose own search need not reach that point.
+    /// Walked, not refined: a refinement walks new nodes into the surrogate's curves and so
+    /// changes every later fit's path (on a knife-edge gait, the benchmark's COM height
+    /// 0.405 L, that alone let a spurious motor line in); a walked nested fit is in the walk
+    /// cache already, so this costs nothing.
     pub fn better_of(&self, fit: Fit, nested: &Fit) -> Result<Fit, GapError> {
-        let other = self.refine(nested)?;
+        let sims = self.walks(&nested.point)?;
+        let other = self.walked_fit(
+            fit.active.clone(),
+            nested.point.clone(),
+            nested.unit.clone(),
+            sims,
+        );
         Ok(if other.chi2 < fit.chi2 { other } else { fit })
     }
 

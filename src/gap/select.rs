@@ -2449,9 +2449,9 @@ impl Selector<'_, '_> {
 /// The best recalibration of every uncertain parameter: Nelder–Mead on the surrogate from
 /// the nominal, from each of the three best single-parameter fits, and from all
 /// single-parameter optima at once, then confirmed and refined with walks. The best
-/// single-parameter fit, the others at their nominal, is walked and refined too (the best
-/// the first step walked, else the best screened): the recalibration nests it, so it never
-/// fits worse than one parameter alone. Where the parameters interact, the surrogate's
+/// single-parameter fit, the others at their nominal, is walked too (the best the first
+/// step walked, else the best screened): the recalibration nests it, so it never fits worse
+/// than one parameter alone. Where the parameters interact, the surrogate's
 /// joint optimum can walk far worse than the nominal: Zippy with hip damping (12
 /// conditions), the recalibration stayed at the nominal's χ² 683 where the foot friction
 /// alone walked 344; and Zippy's gait is rugged enough that μ 0.461 (the screened optimum)
@@ -2483,8 +2483,8 @@ fn recalibrate(
         .filter(|(k, _)| params.contains(k))
         .min_by(|a, b| a.1.chi2.total_cmp(&b.1.chi2));
     let joint = ctx.fit_walked(params, &starts, None, Some(nominal))?;
-    // After the joint search, not among its starts: refining a point walks new nodes into
-    // the surrogate's curves, so a start refined first would change the joint search's path.
+    // After the joint search and only walked, not among its starts: refining a point walks
+    // new nodes into the surrogate's curves, which would change this and every later fit.
     match best_walked.or(by_gain.first().copied()) {
         Some((_, single)) => ctx.better_of(joint, &ctx.embed(single, params)),
         None => Ok(joint),
