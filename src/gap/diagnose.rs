@@ -889,7 +889,7 @@ fn explanations(
     if let Some(e) = best_effect {
         let starts = ctx.starts_adding(nominal, e);
         let f = ctx.with_held_out(ctx.fit_walked(&[e], &starts, None, Some(nominal))?);
-        let alone = f.clone();
+        let alone = f.point.clone();
         out.push(explanation(
             ctx,
             &format!(
@@ -906,7 +906,7 @@ fn explanations(
             let starts = ctx.starts_adding(r, e);
             let mut f = ctx.fit_walked(&active, &starts, None, Some(r))?;
             // It nests the effect alone: walked from there too, it never fits worse.
-            f = ctx.better_of(f, &ctx.embed(&alone, &active))?;
+            f = ctx.better_of(f, &alone)?;
             // Fitted as the chain's test fits it, so the table and the call agree.
             if walked_lm {
                 f = ctx.levenberg_marquardt(f)?;

@@ -346,21 +346,28 @@ impl<'a> FitContext<'a> {
         self.surrogate_fit(active, point, unit, &fit.correction)
     }
 
-    /// `fit`, or the point of `nested` walked if that fits better: for a model that nests
-    /// `nested` (a point of it, `embed`ded), whose own search need not reach that point.
+    /// `fit`, or the point of a model it nests (`nested`, its other knobs at their resting
+    /// values) walked, if that fits better: `fit`'s own search need not reach that point.
     /// Walked, not refined: a refinement walks new nodes into the surrogate's curves and so
     /// changes every later fit's path (on a knife-edge gait, the benchmark's COM height
     /// 0.405 L, that alone let a spurious motor line in); a walked nested fit is in the walk
     /// cache already, so this costs nothing.
-    pub fn better_of(&self, fit: Fit, nested: &Fit) -> Result<Fit, GapError> {
-        let sims = self.walks(&nested.point)?;
-        let other = self.walked_fit(
-            fit.active.clone(),
-            nested.point.clone(),
-            nested.unit.clone(),
-            sims,
-        );
+    pub fn better_of(&self, fit: Fit, nested: &Point) -> Result<Fit, GapError> {
+        let other = self.walked_at(&fit.active, nested.clone())?;
         Ok(if other.chi2 < fit.chi2 { other } else { fit })
+    }
+
+    /// The model `active` walked at `point`, its knobs that `point` leaves unset at their
+    /// resting values.
+    fn walked_at(&self, active: &[usize], mut point: Point) -> Result<Fit, GapError> {
+        for &k in active {
+            if point[k].is_none() {
+                point[k] = Some(self.knobs.list[k].resting());
+            }
+        }
+        let unit = self.unit_of(active, &point);
+        let sims = self.walks(&point)?;
+        Ok(self.walked_fit(active.to_vec(), point, unit, sims))
     }
 
     /// The surrogate fit from starts judged with `base`'s correction (screening, no walks).
@@ -417,14 +424,7 @@ impl<'a> FitContext<'a> {
         {
             let mut point = base.point.clone();
             point[new] = Some(self.knobs.list[new].resting());
-            for &k in active {
-                if point[k].is_none() {
-                    point[k] = Some(self.knobs.list[k].resting());
-                }
-            }
-            let unit = self.unit_of(active, &point);
-            let sims = self.walks(&point)?;
-            let here = self.walked_fit(active.to_vec(), point, unit, sims);
+            let here = self.walked_at(active, point)?;
             if best.as_ref().is_none_or(|b| here.chi2 < b.chi2) {
                 best = Some(here);
             }

@@ -2486,7 +2486,7 @@ fn recalibrate(
     // After the joint search and only walked, not among its starts: refining a point walks
     // new nodes into the surrogate's curves, which would change this and every later fit.
     match best_walked.or(by_gain.first().copied()) {
-        Some((_, single)) => ctx.better_of(joint, &ctx.embed(single, params)),
+        Some((_, single)) => ctx.better_of(joint, &single.point),
         None => Ok(joint),
     }
 }
