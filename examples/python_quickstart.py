@@ -86,6 +86,8 @@ def main() -> None:
     print(f"gap diagnosis of the published trials ({time.perf_counter() - t0:.0f} s):")
     print(f"  {d.summary}")
     print(f"  {d.statement}")
+    for name, p in list(d.probabilities.items())[:3]:
+        print(f"  P({name}) = {p:.3f}")
     print(d.where.select("metric", "n", "rms_z", "mean_relative_pct", "significant"))
 
 

@@ -13,6 +13,7 @@
 //! - [`motors`]: the motor catalogue (scaling laws, actuator datasheets, anchors) and its validation.
 //! - [`checkpoint`]: points files of long runs: resume after an interruption, shards, merge.
 //! - [`report`]: output formats (md, tex, csv, json) and figures.
+//! - [`interop`]: designs as MJCF, URDF and SDF (export) and robot files as designs (import).
 //! - [`io`]: writing files atomically.
 //! - [`progress`]: what long runs report as they go (an [`progress::Observer`]) and their
 //!   timings.
@@ -22,6 +23,7 @@ pub mod checkpoint;
 pub mod crosscheck;
 pub mod dataset;
 pub mod gap;
+pub mod interop;
 pub mod io;
 pub mod motors;
 pub mod progress;

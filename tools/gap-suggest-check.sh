@@ -1,16 +1,15 @@
 #!/usr/bin/env bash
-# Suggest vs default (issue 19, reports/gap-benchmark.md "Suggested trials"): hip Coulomb friction
-# at M N·m (default 0.006, about its summaries' identification threshold against damping on the six
-# test conditions) with 3 % noise; three more trials either suggested by `survey gap suggest` or at
-# the design's own drives (0.97, 1, 1.03×); both sets separated on the summaries alone.
+# Suggested vs default trials: hip Coulomb friction at M N·m (default 0.006, where it and hip
+# damping explain the six test conditions alike) with 3 % noise; three more trials either
+# suggested by `survey gap suggest` or at the design's own drives (0.97, 1, 1.03×); the answer
+# and the truth's posterior after each.
 # Run from the repository root after `cargo build --release`: tools/gap-suggest-check.sh [seeds]
-# Another truth: EFFECT=soft_ground M=1e8 RIVAL=hip_backlash tools/gap-suggest-check.sh 10
+# Another truth: EFFECT=soft_ground M=1e8 tools/gap-suggest-check.sh 10
 # Suggestions off the forward gait too: SUGGEST_ARGS=--any-gait tools/gap-suggest-check.sh 10
 set -euo pipefail
 S="$(pwd)/${SURVEY:-target/release/survey}"
 E="${EFFECT:-hip_coulomb_friction}"
 M="${M:-0.006}"
-RIVAL="${RIVAL:-hip_viscous_damping}"
 N="${1:-10}"
 work="$(mktemp -d)"
 trap 'rm -rf "$work"' EXIT
@@ -22,14 +21,17 @@ d-f0.97x,mugatu-two-uncertain.toml,0.153,1.2028,default repeat
 d-f1x,mugatu-two-uncertain.toml,0.153,1.24,default repeat
 d-f1.03x,mugatu-two-uncertain.toml,0.153,1.2772,default repeat
 CSV
-verdict() {
-  "$S" gap separate --trials "$1" --candidates "$E,$RIVAL" 2>/dev/null \
-    | grep -m1 '^Answer' | sed -e 's/^Answer: \*\*\([^*]*\)\*\*.*/\1/'
+verdict() { # the answer and the truth's probability
+  "$S" gap diagnose --trials "$1" --format json 2>/dev/null | python3 -c '
+import json, sys
+d = json.load(sys.stdin)
+p = {l["explanation"]: l["probability"] for l in d["posterior"]}
+print(f"{d[\"answer\"][\"kind\"]}, P(truth) = {p.get(sys.argv[1], 0.0):.3f}")' "$E"
 }
 for seed in $(seq 1 "$N"); do
   "$S" gap synth --conditions conditions-6.csv --effect "$E=$M" --noise 0.03 --seed "$seed" --out base.csv 2>/dev/null
   # shellcheck disable=SC2086 # SUGGEST_ARGS: extra flags, word-split on purpose
-  "$S" gap suggest --trials base.csv --candidates "$E,$RIVAL" --budget 3 ${SUGGEST_ARGS:-} --out next.csv >/dev/null 2>&1
+  "$S" gap suggest --trials base.csv --budget 3 ${SUGGEST_ARGS:-} --out next.csv >/dev/null 2>&1
   "$S" gap synth --conditions next.csv --effect "$E=$M" --noise 0.03 --seed $((seed + 1000)) --out nextm.csv 2>/dev/null
   "$S" gap synth --conditions default3.csv --effect "$E=$M" --noise 0.03 --seed $((seed + 1000)) --out defm.csv 2>/dev/null
   (cat base.csv; tail -n +2 nextm.csv) > withnext.csv

@@ -34,7 +34,7 @@ fi
 
 # Layers, top (0) to bottom; an arrow must go to a strictly lower layer.
 declare -A layer=(
-  [cli]=0 [report]=1 [gap]=2 [study]=2 [crosscheck]=2 [analysis]=3 [motors]=4 [dataset]=5
+  [cli]=0 [report]=1 [gap]=2 [study]=2 [crosscheck]=2 [analysis]=3 [motors]=4 [dataset]=5 [interop]=5
   [sim]=6 [regression]=6 [checkpoint]=6 [io]=6 [progress]=6
 )
 cd src

@@ -109,6 +109,7 @@ def predict(
     torque_contact: str = "fixed-material",
     torque_margin: float = 2.0,
     table3_points: Optional[_PathLike] = None,
+    speed_kind: str = "top",
 ) -> Prediction: ...
 def walk(
     design: Union[_PathLike, Design] = "mugatu",

@@ -161,8 +161,10 @@ def predict(
     torque_contact: str = "fixed-material",
     torque_margin: float = 2.0,
     table3_points: Optional[PathLike] = None,
+    speed_kind: str = "top",
 ) -> Prediction:
-    """Designer query: what a robot of leg length ``leg_length_m`` weighs and how long it is.
+    """Designer query: what a robot of leg length ``leg_length_m`` weighs, how long it is
+    and how fast it goes.
 
     Parameters
     ----------
@@ -184,6 +186,11 @@ def predict(
         With a design: Table III's contact rule (``"fixed-material"`` or ``"similar"``), the
         stall-torque margin actuators must have, and a Table III points file (default: the
         bundled one).
+    speed_kind:
+        The speed predicted (``"top"``, ``"typical"``, ``"walking"`` or ``"running"``), fitted
+        on the class's robots with a speed of that kind; it is among ``quantities`` (with its
+        Froude number in ``froude``) when the class has enough of them, else
+        ``speed_unavailable`` says why.
     """
     text = _core.predict_json(
         None if leg_length_m is None else float(leg_length_m),
@@ -196,6 +203,7 @@ def predict(
         torque_contact,
         torque_margin,
         fspath(table3_points),
+        speed_kind,
     )
     return Prediction(json.loads(text))
 

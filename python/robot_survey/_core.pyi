@@ -49,6 +49,7 @@ def predict_json(
     torque_contact: str = "fixed-material",
     torque_margin: float = 2.0,
     table3_points: Optional[str] = None,
+    speed_kind: str = "top",
 ) -> str: ...
 def walk(
     design: _DesignArg,
@@ -107,13 +108,12 @@ def gap_diagnose_json(
     effects: Sequence[str] = ...,
     grid: int = 9,
     default_sd: float = 0.10,
-    alpha: float = 0.001,
     calibrate: bool = True,
     reference_path: Optional[str] = None,
     reference_text: Optional[str] = None,
     reference_origin: str = "<DataFrame>",
-    audit_undeclared: bool = True,
-    audit_partners: int = 2,
+    undeclared: bool = True,
+    criterion: Optional[str] = None,
 ) -> Tuple[str, str]: ...
 def trial_columns() -> List[str]: ...
 def builtin_designs() -> List[str]: ...

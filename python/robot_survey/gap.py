@@ -209,15 +209,15 @@ def synth(
 class Diagnosis(Result):
     """``survey gap diagnose --format json`` as an object.
 
-    * ``summary``, ``statement``, ``answer``: the verdict (``answer["kind"]``: within_noise,
-      parameters_off, effect_missing, both, partly_explained, ambiguous, unexplained).
-    * ``where``: per metric, how large the gap is (rms z, mean relative %), whether it is
-      beyond noise, its trends; ``regimes``: per metric, design and size.
-    * ``which``: every knob (effect or uncertain parameter) alone, fitted from the nominal:
-      value, held-out gap, shrink, likelihood ratio, p.
-    * ``how_far``: the competing explanations confirmed with walks: held-out gap, shrink %,
-      p against the nominal, within noise.
-    * ``chain``, ``calibration``, ``identifiability``, ``residuals``: the other tables.
+    * ``statement``, ``answer``: the verdict (``answer["kind"]``: no_gap, parameters_off,
+      effect_missing, both, ambiguous, unexplained), the explanation named with its values'
+      credible intervals, the leading explanations, P(something outside these).
+    * ``posterior``: every explanation weighed and its posterior probability.
+    * ``explanations``: the most probable explanations with prior, evidence, values and
+      intervals, χ² at the mode and the posterior-predictive p.
+    * ``where``: per metric, how large the gap is and its trends; ``regimes``: per metric,
+      design and size.
+    * ``detectable``, ``spread``, ``residuals``: the other tables.
     * ``timing``: wall-clock seconds per phase (not part of the deterministic result).
     """
 
@@ -229,6 +229,23 @@ class Diagnosis(Result):
     def statement(self) -> str:
         """The answer in one sentence."""
         return self._data["answer"]["statement"]
+
+    @property
+    def probabilities(self) -> Dict[str, float]:
+        """Every explanation's posterior probability, most probable first."""
+        return {p["explanation"]: p["probability"] for p in self._data["posterior"]}
+
+    @property
+    def posterior(self) -> pl.DataFrame:
+        """Every explanation and its posterior probability."""
+        return frame(self._data["posterior"])
+
+    @property
+    def explanations(self) -> pl.DataFrame:
+        """The most probable explanations: prior, probability, evidence, fit."""
+        return frame(
+            {k: v for k, v in e.items() if k != "knobs"} for e in self._data["explanations"]
+        )
 
     @property
     def where(self) -> pl.DataFrame:
@@ -243,29 +260,9 @@ class Diagnosis(Result):
         return frame(r for m in self._data["where"] for r in m["regimes"])
 
     @property
-    def which(self) -> pl.DataFrame:
-        """Which knob explains it: every knob alone, from the nominal."""
-        return frame(self._data["single"])
-
-    @property
-    def how_far(self) -> pl.DataFrame:
-        """How far the gap shrinks: the competing explanations, confirmed with walks."""
-        return frame(self._data["explanations"])
-
-    @property
-    def chain(self) -> pl.DataFrame:
-        """The forward selection's steps."""
-        return frame(self._data["chain"])
-
-    @property
-    def calibration(self) -> pl.DataFrame:
-        """The best recalibration of the uncertain parameters."""
-        return frame(self._data["calibration"])
-
-    @property
-    def identifiability(self) -> pl.DataFrame:
-        """Per effect, the magnitudes these trials detect and identify."""
-        return frame(self._data["identifiability"])
+    def detectable(self) -> pl.DataFrame:
+        """Per suspect, the smallest change these trials can tell from nothing."""
+        return frame(self._data["detectable"])
 
     @property
     def residuals(self) -> pl.DataFrame:
@@ -273,7 +270,7 @@ class Diagnosis(Result):
         return frame(self._data["residuals"])
 
     def __repr__(self) -> str:
-        return f"Diagnosis({self._data['answer']['kind']}: {self._data['summary']})"
+        return f"Diagnosis({self._data['answer']['kind']}: {self.statement})"
 
 
 def diagnose(
@@ -282,13 +279,13 @@ def diagnose(
     effects: Optional[Sequence[str]] = None,
     grid: int = 9,
     default_sd: float = 0.10,
-    alpha: float = 0.001,
     calibrate: bool = True,
     reference: Optional[TrialsArg] = None,
-    audit_undeclared: bool = True,
-    audit_partners: int = 2,
+    undeclared: bool = True,
+    criterion: Optional[PathLike] = None,
 ) -> Diagnosis:
-    """Diagnoses trials against the simulator (``survey gap diagnose``); runs with the GIL
+    """Diagnoses trials against the simulator (``survey gap diagnose``): the posterior
+    probability of every explanation and the answer drawn from it; runs with the GIL
     released.
 
     Parameters
@@ -300,27 +297,21 @@ def diagnose(
     effects:
         Candidate effects (names; default: the whole library).
     grid:
-        Magnitudes simulated per candidate across its plausible range.
+        Walks per suspect across its range before its curve is refined.
     default_sd:
         Relative sd assumed where a measurement states none.
-    alpha:
-        Family-wise false-alarm rate of the effect tests.
     calibrate:
-        Calibrate the designs' ``[[uncertain]]`` parameters (False: only effects are
-        candidates).
+        The designs' ``[[uncertain]]`` parameters are suspects (False: only effects and
+        undeclared numbers are).
     reference:
         Trials of the same conditions without the change (``survey gap diagnose
         --reference``): a path or a DataFrame. Each metric is then carried onto the model as
         nominal + (trial − reference), so a discrepancy the model has everywhere (another
         engine, an unmodelled property of the robot) is not blamed on an effect.
-    audit_undeclared:
-        Weigh each named knob against the design's undeclared numbers (False is
-        ``--no-audit-undeclared``): one that an undeclared number fits as well is not named
-        but listed with it as "not told apart".
-    audit_partners:
-        The audit's declared partners (``--audit-partners``; 0: one undeclared number at a
-        time): an undeclared number that explains part of the gap in a named knob's place is
-        weighed again beside the best few declared knobs, for a truth of two numbers.
+    undeclared:
+        The designs' undeclared numbers are suspects too (False is ``--no-undeclared``).
+    criterion:
+        A criterion file in place of the bundled ``dataset/gap/criterion.toml``.
     """
     a = _trials_args(trials)
     r = _trials_args(reference) if reference is not None else None
@@ -332,12 +323,11 @@ def diagnose(
         list(effects or []),
         grid,
         float(default_sd),
-        float(alpha),
         calibrate,
         r["path"] if r else None,
         r["text"] if r else None,
         (r["origin"] or "<DataFrame>") if r else "<DataFrame>",
-        bool(audit_undeclared),
-        int(audit_partners),
+        bool(undeclared),
+        fspath(criterion) if criterion is not None else None,
     )
     return Diagnosis(json.loads(text), json.loads(timing))

@@ -71,6 +71,17 @@ fn contact(s: &str) -> PyResult<ContactScaling> {
     value_enum("contact", s)
 }
 
+fn speed_kind(s: &str) -> PyResult<robot_survey::dataset::SpeedKind> {
+    use robot_survey::dataset::SpeedKind;
+    match SpeedKind::parse(s.trim()) {
+        Some(k) => Ok(k),
+        None => bail(format!(
+            "speed_kind: unknown value `{s}` (one of: {})",
+            SpeedKind::ALL.map(|k| k.as_str()).join(", ")
+        )),
+    }
+}
+
 fn method(s: &str) -> PyResult<Method> {
     match s.trim().to_ascii_lowercase().as_str() {
         "ols" => Ok(Method::Ols),
@@ -163,7 +174,7 @@ fn fit_json(
 /// `survey predict --format json` (with the required hip torque and actuators when the
 /// reference is a walker design and a leg length is given).
 #[pyfunction]
-#[pyo3(signature = (leg_length_m=None, mass_budget_kg=None, cls="lower-biped", from_=None, release=None, path=None, confidence_level=0.95, torque_contact="fixed-material", torque_margin=2.0, table3_points=None))]
+#[pyo3(signature = (leg_length_m=None, mass_budget_kg=None, cls="lower-biped", from_=None, release=None, path=None, confidence_level=0.95, torque_contact="fixed-material", torque_margin=2.0, table3_points=None, speed_kind="top"))]
 #[allow(clippy::too_many_arguments)]
 fn predict_json(
     py: Python<'_>,
@@ -177,9 +188,11 @@ fn predict_json(
     torque_contact: &str,
     torque_margin: f64,
     table3_points: Option<PathBuf>,
+    speed_kind: &str,
 ) -> PyResult<String> {
     use robot_survey::analysis::prediction as p;
     let class = group(cls)?;
+    let speed_kind = self::speed_kind(speed_kind)?;
     let level = confidence(confidence_level)?;
     let torque_contact = contact(torque_contact)?;
     detached(py, || {
@@ -201,6 +214,7 @@ fn predict_json(
             mass_budget_kg,
             reference,
             confidence: level,
+            speed_kind,
         };
         let pred = p::predict(&table, class, &req)?;
         let design = from_.as_deref().and_then(|r| r.strip_prefix("design:"));
@@ -614,10 +628,10 @@ fn gap_synth_csv(
 
 /// `survey gap diagnose --format json`, and the wall-clock timing (not part of the result).
 /// `reference_*`: the reference trials (`survey gap diagnose --reference`), as path or text
-/// like the trials; `audit_undeclared` false is `--no-audit-undeclared`, `audit_partners`
-/// is `--audit-partners`.
+/// like the trials; `undeclared` false is `--no-undeclared`, `criterion` a criterion file
+/// (`--criterion`).
 #[pyfunction]
-#[pyo3(signature = (path=None, text=None, origin="<DataFrame>", base_dir=None, effects=Vec::new(), grid=9, default_sd=0.10, alpha=0.001, calibrate=true, reference_path=None, reference_text=None, reference_origin="<DataFrame>", audit_undeclared=true, audit_partners=gap::audit::PARTNERS))]
+#[pyo3(signature = (path=None, text=None, origin="<DataFrame>", base_dir=None, effects=Vec::new(), grid=9, default_sd=0.10, calibrate=true, reference_path=None, reference_text=None, reference_origin="<DataFrame>", undeclared=true, criterion=None))]
 #[allow(clippy::too_many_arguments)]
 fn gap_diagnose_json(
     py: Python<'_>,
@@ -628,13 +642,12 @@ fn gap_diagnose_json(
     effects: Vec<String>,
     grid: usize,
     default_sd: f64,
-    alpha: f64,
     calibrate: bool,
     reference_path: Option<PathBuf>,
     reference_text: Option<String>,
     reference_origin: &str,
-    audit_undeclared: bool,
-    audit_partners: usize,
+    undeclared: bool,
+    criterion: Option<PathBuf>,
 ) -> PyResult<(String, String)> {
     let origin = origin.to_string();
     let reference_origin = reference_origin.to_string();
@@ -642,23 +655,21 @@ fn gap_diagnose_json(
         let lib = EffectLibrary::bundled()?;
         let base = base_dir.as_deref().unwrap_or(Path::new("."));
         let set = trials_of(path.as_deref(), text.as_deref(), &origin, base)?;
-        let reference = optional_trials_of(
+        let mut opts = DiagnoseOptions::new()?;
+        opts.reference = optional_trials_of(
             reference_path.as_deref(),
             reference_text.as_deref(),
             &reference_origin,
             base,
         )?;
-        let opts = DiagnoseOptions {
-            effects,
-            grid_points: grid,
-            default_relative_sd: default_sd,
-            alpha,
-            calibrate,
-            reference,
-            audit_undeclared,
-            audit_partners,
-            ..DiagnoseOptions::default()
-        };
+        opts.effects = effects;
+        opts.grid_points = grid;
+        opts.default_relative_sd = default_sd;
+        opts.calibrate = calibrate;
+        opts.undeclared = undeclared;
+        if let Some(c) = criterion {
+            opts.criterion = gap::criterion::Criterion::read(&c)?;
+        }
         let (d, timing) = gap::diagnose(&set, &lib, &opts, &Silent)?;
         Ok((report::json(&d)?, serde_json::to_string(&timing)?))
     })

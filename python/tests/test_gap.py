@@ -3,16 +3,20 @@ the same inputs and against a cause known by construction."""
 
 from __future__ import annotations
 
+import shutil
+
 import polars as pl
 import pytest
 
 import robot_survey as rs
+from conftest import REPO
 from robot_survey import gap
 
-# A small diagnosis (6 conditions, one candidate, 4 grid points, no calibration): seconds,
-# not minutes, in the CI's dev build.
-DIAG = dict(effects=["hip_viscous_damping"], grid=4, calibrate=False)
-DIAG_FLAGS = ["--effects", "hip_viscous_damping", "--grid", "4", "--no-calibration"]
+# A small diagnosis (6 conditions, one candidate, 4 grid points, no parameters among the
+# suspects): seconds, not minutes, in the CI's dev build.
+DIAG = dict(effects=["hip_viscous_damping"], grid=4, calibrate=False, undeclared=False)
+DIAG_FLAGS = ["--effects", "hip_viscous_damping", "--grid", "4", "--no-calibration",
+              "--no-undeclared"]
 
 
 @pytest.fixture(scope="module")
@@ -80,31 +84,34 @@ def test_diagnose_equals_the_clis_json(cli, trials_file, diagnosis):
     assert diagnosis.to_dict() == want
 
 
-def test_diagnose_without_the_audit_equals_the_clis(cli, trials_file, diagnosis):
-    """``audit_undeclared=False`` is ``--no-audit-undeclared``; the default audits."""
+def test_diagnose_with_the_undeclared_numbers_equals_the_clis(cli, trials_file, diagnosis):
+    """``undeclared=True`` (the default) weighs the design's undeclared numbers too: more
+    explanations than without them, the same answer as the CLI's."""
     _, small = trials_file
-    got = gap.diagnose(small, audit_undeclared=False, **DIAG).to_dict()
-    want = cli.json("gap", "diagnose", "--trials", str(small), *DIAG_FLAGS,
-                    "--no-audit-undeclared", "--format", "json")
+    opts = {k: v for k, v in DIAG.items() if k != "undeclared"}
+    got = gap.diagnose(small, **opts).to_dict()
+    flags = [f for f in DIAG_FLAGS if f != "--no-undeclared"]
+    want = cli.json("gap", "diagnose", "--trials", str(small), *flags, "--format", "json")
     assert got == want
-    assert not any(n.startswith("undeclared-parameter audit") for n in got["notes"])
-    assert any(n.startswith("undeclared-parameter audit") for n in diagnosis.to_dict()["notes"])
+    assert got["weighed"] > diagnosis.to_dict()["weighed"]
 
 
 def test_diagnose_names_the_effect_that_made_the_trials(diagnosis):
     """The trials were made with hip viscous damping 0.01 N·m·s/rad: the answer names it,
-    with an interval that holds the truth, and the gap shrinks on held-out conditions."""
+    with a credible interval that holds the truth, and its probability is the posterior's
+    largest."""
     a = diagnosis.answer
     assert a["kind"] == "effect_missing", diagnosis.statement
-    (named,) = a["effects"]
-    assert named["knob"] == "hip_viscous_damping"
+    assert a["explanation"] == "hip_viscous_damping"
+    (named,) = a["named"]
     lo, hi = named["interval"]
     assert lo <= 0.01 <= hi
-    how_far = diagnosis.how_far
-    answer = how_far.filter(pl.col("model") == "the chain (the answer)").row(0, named=True)
-    assert answer["within_noise"] and answer["shrink_pct"] > 50
+    probs = diagnosis.probabilities
+    assert next(iter(probs)) == "hip_viscous_damping"
+    assert probs["hip_viscous_damping"] >= diagnosis.to_dict()["criterion"]["decision"]["threshold"]
+    assert abs(sum(probs.values()) - 1.0) < 1e-9
     assert diagnosis.where.height >= 1 and "rms_z" in diagnosis.where.columns
-    assert diagnosis.which["knob"].to_list() == ["hip_viscous_damping"]
+    assert diagnosis.explanations["explanation"][0] == "hip_viscous_damping"
     assert set(diagnosis.timing) >= {"grid_s", "walks"}
 
 
@@ -139,7 +146,7 @@ def test_bad_trials_name_line_and_column(cli, trials_file, tmp_path):
 
 def test_diagnose_through_a_reference_equals_the_clis_json(cli, trials_file, tmp_path):
     """`reference=` is `--reference`; trials taken as their own reference change nothing,
-    so every metric is carried onto the nominal itself and the answer is within noise."""
+    so every metric is carried onto the nominal itself and the answer is no gap."""
     _, small = trials_file
     ref = tmp_path / "ref.csv"
     cli.run("gap", "synth", "--conditions", str(small), "--noise", "0.05", "--seed", "2",
@@ -150,7 +157,26 @@ def test_diagnose_through_a_reference_equals_the_clis_json(cli, trials_file, tmp
     assert got.to_dict() == want
     same = gap.diagnose(small, reference=gap.read_trials(small.read_text(encoding="utf-8")),
                         **DIAG)
-    assert same.answer["kind"] == "within_noise", same.statement
+    assert same.answer["kind"] == "no_gap", same.statement
     other = gap.read_trials(small.read_text(encoding="utf-8")).head(3)
     with pytest.raises(rs.SurveyError, match="reference"):
         gap.diagnose(small, reference=other, **DIAG)
+
+
+def test_one_answer_in_python_json_and_text_on_trials_with_logs(cli, tmp_path):
+    """Trials whose rows name robot logs (the CLI's synth with ``--logs``): the logged cycles
+    enter the likelihood, and Python, the CLI's JSON and the CLI's text give one answer."""
+    shutil.copy(REPO / "tests/data/gap/mugatu-two-uncertain.toml", tmp_path)
+    trials, logs = tmp_path / "t.csv", tmp_path / "logs"
+    cli.run("gap", "synth", "--conditions", str(REPO / "tests/data/gap/conditions-6.csv"),
+            "--effect", "hip_coulomb_friction=0.02", "--noise", "0.03", "--seed", "7",
+            "--out", str(trials), "--logs", str(logs))
+    effects = ["hip_coulomb_friction", "hip_viscous_damping"]
+    flags = ["--effects", ",".join(effects), "--no-undeclared"]
+    got = gap.diagnose(trials, effects=effects, undeclared=False).to_dict()
+    want = cli.json("gap", "diagnose", "--trials", str(trials), *flags, "--format", "json")
+    assert got == want
+    assert got["logged_trials"] == 6 and got["n_cycle_observations"] > 100
+    text = cli.stdout("gap", "diagnose", "--trials", str(trials), *flags)
+    assert got["answer"]["statement"] in text
+    assert got["answer"]["explanation"] == "hip_coulomb_friction", got["answer"]["statement"]

@@ -1,12 +1,17 @@
 //! The data of the survey figure (`survey fit --out`: survey.svg, survey.png, survey.html):
-//! for each Table 2 relation, every robot with both values, each class's fitted power law
-//! over its data range and the confidence band of that line. `report/` draws it.
+//! for each Table 2 relation and for top speed against leg length, every robot with both
+//! values, each class's fitted power law over its data range and the confidence band of that
+//! line. `report/` draws it.
 
 use crate::analysis::table2::{
-    Group, LogPoints, PowerLawRow, TABLE2_PAIRS, Table2, Var, log_points,
+    Group, LogPoints, Numeric, PowerLawRow, TABLE2_PAIRS, Table2, Var, fit_group, log_points,
 };
-use crate::dataset::{RobotClass, SurveyRow, SurveyTable};
+use crate::dataset::validate::G_MPS2;
+use crate::dataset::{RobotClass, SpeedKind, SurveyRow, SurveyTable};
 use crate::regression::{self, Method};
+
+/// The speed panel of the figure: top speed against leg length.
+pub const SPEED_PANEL: (Var, Var) = (Var::LegLength, Var::SpeedTop);
 
 /// One robot in one panel.
 #[derive(Debug, Clone)]
@@ -18,6 +23,8 @@ pub struct FigurePoint {
     pub exclusion: Option<String>,
     /// Leg length, body length and mass cells of the compiled table (text as released).
     pub values: [Option<String>; 3],
+    /// The robot's speeds of each kind it has (cells as released).
+    pub speeds: Vec<(SpeedKind, String)>,
     pub x: f64,
     pub y: f64,
 }
@@ -44,6 +51,16 @@ pub struct FigurePanel {
     pub all: Option<PowerLawRow>,
     /// Robots without both values (or with a value a log axis cannot show): (id, name, why).
     pub missing: Vec<(String, String, String)>,
+    /// Reference laws drawn dashed across the panel (the speed panel: Froude 1).
+    pub references: Vec<ReferenceLine>,
+}
+
+/// A reference law y = a·x^b, not fitted.
+#[derive(Debug, Clone)]
+pub struct ReferenceLine {
+    pub label: String,
+    pub a: f64,
+    pub b: f64,
 }
 
 /// The data of the figure, computed from the table and its Table 2 fits.
@@ -77,21 +94,39 @@ fn row_point(r: &SurveyRow, x: Var, y: Var) -> Result<FigurePoint, String> {
         class: r.class,
         fit: r.fit,
         exclusion: r.exclusion.clone(),
-        values: Var::ALL.map(|v| r.cells.get(v.field()).filter(|s| !s.is_empty()).cloned()),
+        values: Var::SIZES.map(|v| r.cells.get(v.field()).filter(|s| !s.is_empty()).cloned()),
+        speeds: SpeedKind::ALL
+            .into_iter()
+            .filter_map(|k| Some((k, r.cells.get(k.field()).filter(|s| !s.is_empty())?.clone())))
+            .collect(),
         x: px,
         y: py,
     })
 }
 
 /// Builds the figure: every row of the table in every panel it has values for, and each
-/// class's Table 2 line with its band (OLS only: the band is the mean interval of the
-/// OLS prediction at each x).
+/// class's line with its band (OLS only: the band is the mean interval of the OLS
+/// prediction at each x): Table 2's three relations, then top speed against leg length
+/// (fitted here the same way, for classes with enough robots with a top speed).
 pub fn survey_figure(table: &SurveyTable, t2: &Table2) -> SurveyFigure {
     let confidence = t2.fits.first().map(|f| f.confidence).unwrap_or(0.95);
-    let panels = TABLE2_PAIRS
+    let mut panels: Vec<FigurePanel> = TABLE2_PAIRS
         .into_iter()
-        .map(|(x, y)| figure_panel(table, t2, x, y, confidence))
+        .map(|(x, y)| figure_panel(table, &t2.fits, x, y, confidence))
         .collect();
+    let (x, y) = SPEED_PANEL;
+    let data = Numeric::of(table);
+    let speed_fits: Vec<PowerLawRow> = Group::TABLE2
+        .into_iter()
+        .filter_map(|g| fit_group(&data, g, x, y, t2.method, confidence, None).ok())
+        .collect();
+    let mut speed = figure_panel(table, &speed_fits, x, y, confidence);
+    speed.references.push(ReferenceLine {
+        label: "Froude 1 (walk–run limit): v = √(gL)".into(),
+        a: G_MPS2.sqrt(),
+        b: 0.5,
+    });
+    panels.push(speed);
     SurveyFigure {
         version: table.version.clone(),
         sha256: table.sha256.clone(),
@@ -103,8 +138,14 @@ pub fn survey_figure(table: &SurveyTable, t2: &Table2) -> SurveyFigure {
 }
 
 /// One relation: its points (and the robots it cannot show), the class lines and the
-/// all-classes fit.
-fn figure_panel(table: &SurveyTable, t2: &Table2, x: Var, y: Var, confidence: f64) -> FigurePanel {
+/// all-classes fit, from `fits`.
+fn figure_panel(
+    table: &SurveyTable,
+    fits: &[PowerLawRow],
+    x: Var,
+    y: Var,
+    confidence: f64,
+) -> FigurePanel {
     let mut points = Vec::new();
     let mut missing = Vec::new();
     for r in &table.rows {
@@ -115,19 +156,19 @@ fn figure_panel(table: &SurveyTable, t2: &Table2, x: Var, y: Var, confidence: f6
     }
     let lines = RobotClass::FITTED
         .into_iter()
-        .filter_map(|c| class_line(table, t2, c, x, y, confidence))
+        .filter_map(|c| class_line(table, fits, c, x, y, confidence))
         .collect();
     FigurePanel {
         x,
         y,
-        all: t2
-            .fits
+        all: fits
             .iter()
             .find(|f| f.class == Group::All && f.x == x && f.y == y)
             .cloned(),
         points,
         lines,
         missing,
+        references: Vec::new(),
     }
 }
 
@@ -135,15 +176,14 @@ fn figure_panel(table: &SurveyTable, t2: &Table2, x: Var, y: Var, confidence: f6
 /// without a range to draw).
 fn class_line(
     table: &SurveyTable,
-    t2: &Table2,
+    fits: &[PowerLawRow],
     c: RobotClass,
     x: Var,
     y: Var,
     confidence: f64,
 ) -> Option<FigureLine> {
     let g = Group::Class(c);
-    let fit = t2
-        .fits
+    let fit = fits
         .iter()
         .find(|f| f.class == g && f.x == x && f.y == y)?
         .clone();
@@ -153,7 +193,7 @@ fn class_line(
     if !(lo.is_finite() && hi.is_finite() && hi > lo) {
         return None;
     }
-    let band = match t2.method {
+    let band = match fit.method {
         Method::Ols => ols_band(&pts, lo, hi, confidence),
         _ => Vec::new(),
     };

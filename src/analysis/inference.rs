@@ -5,11 +5,10 @@
 
 use serde::Serialize;
 
-use crate::analysis::table2::{DatasetRef, Group, Var, isometric_exponent, log_points};
+use crate::analysis::relation::{Hypothesis, HypothesisTest, test_hypotheses};
+use crate::analysis::table2::{DatasetRef, Group, Var, log_points};
 use crate::dataset::{RobotClass, SurveyTable};
-use crate::regression::{
-    self, CommonSlopeTest, ElevationComparison, Method, RegressionError, SlopeTest,
-};
+use crate::regression::{self, CommonSlopeTest, ElevationComparison, Method, RegressionError};
 
 /// `survey test slope`.
 #[derive(Debug, Clone, Serialize)]
@@ -18,12 +17,11 @@ pub struct SlopeTestReport {
     pub class: Group,
     pub x: Var,
     pub y: Var,
-    /// The hypothesised exponent and why (given, or isometric).
-    pub hypothesis: String,
     pub confidence: f64,
     /// Fitted exponent with its interval.
     pub b_ci: [f64; 2],
-    pub test: SlopeTest,
+    /// Each hypothesised exponent (given, or the scaling laws') and its test.
+    pub tests: Vec<HypothesisTest>,
 }
 
 /// `survey test common-slope` and `survey test elevation`.
@@ -38,34 +36,33 @@ pub struct GroupComparisonReport {
     pub elevation: Option<ElevationComparison>,
 }
 
-/// Tests b = `value` (default: the isometric exponent) for one class.
+/// Tests each hypothesised exponent for one class (smatr's `slope.test`).
 pub fn slope(
     table: &SurveyTable,
     class: Group,
     x: Var,
     y: Var,
     method: Method,
-    value: Option<f64>,
+    hypotheses: &[Hypothesis],
     confidence: f64,
 ) -> Result<SlopeTestReport, RegressionError> {
+    if hypotheses.is_empty() {
+        return Err(RegressionError::InvalidArgument(
+            "no exponent to test".into(),
+        ));
+    }
     let p = log_points(table, class, x, y)?;
     let (lx, ly) = (&p.lx, &p.ly);
-    let b0 = value.unwrap_or_else(|| isometric_exponent(x, y));
-    let hypothesis = match value {
-        Some(v) => format!("b = {v}"),
-        None => format!("b = {b0} (isometry)"),
-    };
     let fit = regression::fit_line(lx, ly, method, confidence)?;
-    let test = regression::slope_test(lx, ly, method, b0)?;
+    let tests = test_hypotheses(lx, ly, method, hypotheses, confidence)?;
     Ok(SlopeTestReport {
         dataset: DatasetRef::of(table),
         class,
         x,
         y,
-        hypothesis,
         confidence,
         b_ci: [fit.b_ci.lower, fit.b_ci.upper],
-        test,
+        tests,
     })
 }
 

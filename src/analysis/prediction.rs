@@ -10,8 +10,9 @@
 
 use serde::Serialize;
 
+use crate::analysis::relation::froude;
 use crate::analysis::table2::{DatasetRef, Group, Var, log_points};
-use crate::dataset::SurveyTable;
+use crate::dataset::{SpeedKind, SurveyTable};
 use crate::regression::{self, BiasCorrection, Method, PowerLawFit, RegressionError};
 
 /// A reference robot or design to scale from.
@@ -84,6 +85,17 @@ pub struct ScaledReference {
     pub body_length_isometric_m: Option<f64>,
 }
 
+/// The Froude number v²/(gL) of the predicted speed at the target leg length.
+#[derive(Debug, Clone, Serialize)]
+pub struct FroudePrediction {
+    /// Of the bias-corrected mean speed.
+    pub mean: f64,
+    /// Of the median speed.
+    pub median: f64,
+    /// Of the limits of the speed's prediction interval.
+    pub prediction_interval: [f64; 2],
+}
+
 /// The answer to `survey predict`.
 #[derive(Debug, Clone, Serialize)]
 pub struct Prediction {
@@ -98,6 +110,13 @@ pub struct Prediction {
     pub scaled_reference: Option<ScaledReference>,
     /// Set when the target lies outside the class data range.
     pub extrapolation: Option<String>,
+    /// The kind of speed predicted (a speed is among `quantities` when the class has
+    /// enough robots with a speed of this kind).
+    pub speed_kind: SpeedKind,
+    /// The Froude number of the predicted speed.
+    pub froude: Option<FroudePrediction>,
+    /// Why no speed is predicted (too few robots with a speed of the kind, no leg length).
+    pub speed_unavailable: Option<String>,
 }
 
 impl Prediction {
@@ -140,6 +159,8 @@ pub struct PredictRequest {
     pub mass_budget_kg: Option<f64>,
     pub reference: Option<Reference>,
     pub confidence: f64,
+    /// The kind of speed predicted at the target leg length.
+    pub speed_kind: SpeedKind,
 }
 
 /// Errors of a prediction request.
@@ -283,6 +304,7 @@ pub fn predict(
     let mass_fit = class_fit(table, class, Var::LegLength, Var::Mass)?;
     let mut quantities = Vec::new();
     let mut extrapolation = None;
+    let (mut froude_at, mut speed_unavailable) = (None, None);
     if let Some(l) = req.leg_length_m {
         let l = positive("leg length", l)?;
         let body_fit = class_fit(table, class, Var::LegLength, Var::BodyLength)?;
@@ -293,6 +315,19 @@ pub fn predict(
             }
             quantities.push(q);
         }
+        match predict_speed(table, class, l, req) {
+            Ok(q) => {
+                froude_at = Some(FroudePrediction {
+                    mean: froude(q.mean, l),
+                    median: froude(q.median, l),
+                    prediction_interval: q.prediction_interval.map(|v| froude(v, l)),
+                });
+                quantities.push(q);
+            }
+            Err(why) => speed_unavailable = Some(why),
+        }
+    } else {
+        speed_unavailable = Some("a speed is predicted for a target leg length".into());
     }
     let inverse = match req.mass_budget_kg {
         None => None,
@@ -344,7 +379,33 @@ pub fn predict(
         inverse,
         scaled_reference,
         extrapolation,
+        speed_kind: req.speed_kind,
+        froude: froude_at,
+        speed_unavailable,
     })
+}
+
+/// The speed of the requested kind at leg length `l`, or why the class cannot predict it
+/// (fewer robots with such a speed than a fit needs).
+fn predict_speed(
+    table: &SurveyTable,
+    class: Group,
+    l: f64,
+    req: &PredictRequest,
+) -> Result<QuantityPrediction, String> {
+    let y = Var::speed(req.speed_kind);
+    let n = crate::analysis::table2::points(table, class, Var::LegLength, y).len();
+    if n < crate::analysis::relation::MIN_FIT_N {
+        return Err(format!(
+            "{n} {} robot(s) of dataset {} have a {} (a fit needs {})",
+            class.as_str(),
+            table.version,
+            y.label(),
+            crate::analysis::relation::MIN_FIT_N
+        ));
+    }
+    let cf = class_fit(table, class, Var::LegLength, y).map_err(|e| e.to_string())?;
+    predict_quantity(&cf, l, req.confidence).map_err(|e| e.to_string())
 }
 
 /// A reference from a record of the table (its leg length, mass and body length).

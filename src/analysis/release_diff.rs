@@ -98,6 +98,9 @@ pub struct FieldChange {
     /// Where in the source the new value is, when the record says.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub at: Option<String>,
+    /// For a speed: the gait the record gives the new value in (a release keeps no gait).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub gait: Option<String>,
     /// The live value's note, if any.
     pub note: Option<String>,
 }
@@ -328,6 +331,7 @@ fn field_changes(
                 new: n,
                 sources: Vec::new(),
                 at: None,
+                gait: None,
                 note: None,
             });
         }
@@ -359,6 +363,9 @@ fn field_changes(
             at: robot
                 .and_then(|r| r.values.get(*c))
                 .and_then(|d| d.at.clone()),
+            gait: robot
+                .and_then(|r| r.values.get(*c))
+                .and_then(|d| d.gait.clone()),
             note: robot
                 .and_then(|r| r.values.get(*c))
                 .and_then(|d| d.note.clone()),

@@ -69,16 +69,21 @@ pub struct Table2 {
     pub fits: Vec<PowerLawRow>,
 }
 
-/// The isometric exponent of y against x: lengths ∝ L, mass ∝ L³.
+/// The isometric exponent of y against x under geometric and dynamic similarity: lengths
+/// ∝ L, mass ∝ L³, speeds ∝ L^0.5 (equal Froude number v²/(gL)).
 pub fn isometric_exponent(x: Var, y: Var) -> f64 {
-    let dim = |v: Var| if v == Var::Mass { 3.0 } else { 1.0 };
+    let dim = |v: Var| match v {
+        Var::LegLength | Var::BodyLength => 1.0,
+        Var::Mass => 3.0,
+        _ => 0.5,
+    };
     dim(y) / dim(x)
 }
 
-/// The three survey variables of every row, parsed once (a table of a million robots
-/// is fitted 15 times; parsing each cell once keeps that under a second).
+/// The survey variables of every row, parsed once (a table of a million robots is fitted
+/// 15 times; parsing each cell once keeps that under a second).
 pub struct Numeric {
-    rows: Vec<(RobotClass, bool, [Option<f64>; 3])>,
+    rows: Vec<(RobotClass, bool, [Option<f64>; Var::ALL.len()])>,
 }
 
 impl Numeric {
@@ -94,7 +99,7 @@ impl Numeric {
 
     /// (x, y) of the fitted robots of `group` that have both variables.
     pub fn select(&self, group: Group, x: Var, y: Var) -> (Vec<f64>, Vec<f64>) {
-        let (ix, iy) = (x as usize, y as usize);
+        let (ix, iy) = (x.index(), y.index());
         self.rows
             .iter()
             .filter(|(class, fit, _)| group.includes(*class, *fit))
@@ -230,8 +235,18 @@ pub fn explain(
     group: Group,
     method: Method,
 ) -> Result<Explanation, regression::RegressionError> {
+    explain_relations(table, group, method, &TABLE2_PAIRS)
+}
+
+/// Refits each (x, y) relation of `group` without each robot in turn.
+pub fn explain_relations(
+    table: &SurveyTable,
+    group: Group,
+    method: Method,
+    pairs: &[(Var, Var)],
+) -> Result<Explanation, regression::RegressionError> {
     let mut relations = Vec::new();
-    for (x, y) in TABLE2_PAIRS {
+    for &(x, y) in pairs {
         let p = log_points(table, group, x, y)?;
         let full = regression::fit_line(&p.lx, &p.ly, method, 0.95)?;
         let loo = regression::leave_one_out(&p.lx, &p.ly, method)?;

@@ -48,6 +48,23 @@ impl From<MethodArg> for Method {
     }
 }
 
+/// A survey variable by name: `speed` is the speed of `kind`; otherwise leg_length,
+/// body_length, mass or a speed of a named kind (speed_top, …).
+pub fn parse_var(
+    s: &str,
+    kind: robot_survey::dataset::SpeedKind,
+) -> anyhow::Result<robot_survey::analysis::table2::Var> {
+    use robot_survey::analysis::table2::Var;
+    if s == "speed" {
+        return Ok(Var::speed(kind));
+    }
+    Var::parse(s).ok_or_else(|| {
+        anyhow::anyhow!(
+            "unknown variable `{s}` (one of: leg_length, body_length, mass, speed — with --speed-kind top|typical|walking|running|unstated)"
+        )
+    })
+}
+
 /// Parses a confidence level, which must lie in (0, 1).
 pub fn parse_confidence(s: &str) -> Result<f64, String> {
     let c: f64 = s.parse().map_err(|_| format!("`{s}` is not a number"))?;
@@ -65,6 +82,18 @@ pub enum SimFormat {
     #[default]
     Text,
     Json,
+}
+
+/// Tells on stderr which files a command wrote.
+pub fn report_written(paths: &[PathBuf]) {
+    eprintln!(
+        "wrote {}",
+        paths
+            .iter()
+            .map(|p| p.display().to_string())
+            .collect::<Vec<_>>()
+            .join(", ")
+    );
 }
 
 /// Writes `text` to stdout, ignoring a closed pipe (`survey fit | head`).

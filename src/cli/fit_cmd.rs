@@ -9,7 +9,7 @@ use robot_survey::analysis::table2::{self, Group};
 use robot_survey::dataset::Dataset;
 use robot_survey::report::{self, Format};
 
-use super::common::{DatasetArgs, MethodArg, parse_confidence, print};
+use super::common::{DatasetArgs, MethodArg, parse_confidence, parse_var, print, report_written};
 
 #[derive(Args, Debug)]
 pub struct FitArgs {
@@ -39,6 +39,19 @@ pub struct FitArgs {
     /// List the robots of CLASS that move each exponent most (leave-one-out change in b).
     #[arg(long, value_name = "CLASS")]
     pub explain: Option<String>,
+    /// Fit one relation instead of Table 2: y ∝ x^b per class, with the slope tests of the
+    /// scaling laws (dataset/laws/table1.toml) and of no trend (b = 0). `speed` fits the
+    /// speed of --speed-kind, and adds each class's Froude numbers v²/(gL); with --out it
+    /// writes the speed report (speed.md, speed.json, speed-froude.svg/.png).
+    #[arg(long, value_name = "VAR")]
+    pub y: Option<String>,
+    /// Explanatory variable of --y: leg_length or body_length.
+    #[arg(long, value_name = "VAR", default_value = "leg_length", requires = "y")]
+    pub x: String,
+    /// Which speeds `--y speed` fits: top (the highest reported), typical, walking, running,
+    /// or unstated (the survey's speeds of unknown kind, releases up to 1.4.0).
+    #[arg(long, value_enum, default_value_t)]
+    pub speed_kind: robot_survey::dataset::SpeedKind,
 }
 
 pub fn parse_group(s: &str) -> anyhow::Result<Group> {
@@ -50,6 +63,9 @@ pub fn parse_group(s: &str) -> anyhow::Result<Group> {
 pub fn fit(a: &FitArgs) -> anyhow::Result<ExitCode> {
     let ds = Dataset::locate(a.data.dataset.as_deref())?;
     let table = ds.table(a.data.release.as_deref())?;
+    if let Some(y) = &a.y {
+        return fit_relation(a, &ds, &table, y);
+    }
     if let Some(class) = &a.explain {
         let g = parse_group(class)?;
         let ex = table2::explain(&table, g, a.method.into())?;
@@ -94,17 +110,98 @@ pub fn fit(a: &FitArgs) -> anyhow::Result<ExitCode> {
             report::html::survey_html(&robot_survey::analysis::figure::survey_figure(&table, &t2));
         robot_survey::dataset::canonical::write_atomic(&path, page.as_bytes())?;
         written.push(path);
-        eprintln!(
-            "wrote {}",
-            written
-                .iter()
-                .map(|p| p.display().to_string())
-                .collect::<Vec<_>>()
-                .join(", ")
-        );
+        report_written(&written);
     }
     print(&report::table2(&t2, a.format)?);
     Ok(ExitCode::SUCCESS)
+}
+
+/// `survey fit --y VAR`: one relation per class (its influence with --explain), and with
+/// --out its files (the speed report for a speed against leg length).
+fn fit_relation(
+    a: &FitArgs,
+    ds: &Dataset,
+    table: &robot_survey::dataset::SurveyTable,
+    y: &str,
+) -> anyhow::Result<ExitCode> {
+    use robot_survey::analysis::relation::{RelationSpec, default_hypotheses, relation_fits};
+    let (x, y) = (parse_var(&a.x, a.speed_kind)?, parse_var(y, a.speed_kind)?);
+    if let Some(class) = &a.explain {
+        let g = parse_group(class)?;
+        let ex = table2::explain_relations(table, g, a.method.into(), &[(x, y)])?;
+        print(&match a.format {
+            Format::Json => report::json(&ex)?,
+            _ => report::explain_text(&ex),
+        });
+        return Ok(ExitCode::SUCCESS);
+    }
+    let spec = RelationSpec {
+        x,
+        y,
+        method: a.method.into(),
+        confidence: a.confidence,
+        hypotheses: default_hypotheses(ds, x, y)?,
+        bootstrap: a
+            .bootstrap
+            .map(|n| robot_survey::regression::BootstrapConfig {
+                replicates: n as usize,
+                seed: a.seed,
+                level: a.confidence,
+            }),
+    };
+    let fits = relation_fits(table, &spec)?;
+    if let Some(dir) = &a.out {
+        write_relation_files(dir, a, ds, table, &spec, &fits)?;
+    }
+    print(&report::speed::relation(&fits, a.format)?);
+    Ok(ExitCode::SUCCESS)
+}
+
+/// The files of `survey fit --y VAR --out DIR`: for a speed against leg length the speed
+/// report (speed.md, speed.json, speed-froude.svg and .png), else the relation's table
+/// (Y-vs-X.md, .csv, .json).
+fn write_relation_files(
+    dir: &std::path::Path,
+    a: &FitArgs,
+    ds: &Dataset,
+    table: &robot_survey::dataset::SurveyTable,
+    spec: &robot_survey::analysis::relation::RelationSpec,
+    fits: &robot_survey::analysis::relation::RelationFits,
+) -> anyhow::Result<()> {
+    use robot_survey::dataset::canonical::write_atomic;
+    std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
+    let mut written = Vec::new();
+    if spec.y.speed_kind().is_some() && spec.x == table2::Var::LegLength {
+        let live = a.data.release.is_none();
+        let rep = robot_survey::analysis::speed::speed_report(ds, table, live, spec)?;
+        for (name, text) in [
+            ("speed.md", report::speed::speed_report_md(&rep)),
+            ("speed.json", report::json(&rep)?),
+        ] {
+            let path = dir.join(name);
+            write_atomic(&path, text.as_bytes())?;
+            written.push(path);
+        }
+        let panel = report::plot::froude_panel(&rep);
+        for name in ["speed-froude.svg", "speed-froude.png"] {
+            let path = dir.join(name);
+            report::plot::draw_panels(&path, std::slice::from_ref(&panel), (1000, 700))?;
+            written.push(path);
+        }
+    } else {
+        let stem = format!("{}-vs-{}", spec.y.as_str(), spec.x.as_str());
+        for (fmt, ext) in [
+            (Format::Md, "md"),
+            (Format::Csv, "csv"),
+            (Format::Json, "json"),
+        ] {
+            let path = dir.join(format!("{stem}.{ext}"));
+            write_atomic(&path, report::speed::relation(fits, fmt)?.as_bytes())?;
+            written.push(path);
+        }
+    }
+    report_written(&written);
+    Ok(())
 }
 
 #[derive(Args, Debug)]
@@ -136,6 +233,10 @@ pub struct PredictArgs {
     /// Output: md (text) or json.
     #[arg(long, value_enum, default_value_t)]
     pub format: Format,
+    /// Which speed is predicted at the target leg length: top (the highest reported),
+    /// typical, walking or running; fitted on the class's robots with a speed of that kind.
+    #[arg(long, value_enum, default_value_t)]
+    pub speed_kind: robot_survey::dataset::SpeedKind,
     /// Also draw mass vs leg length with each class's prediction band (SVG or PNG by extension).
     #[arg(long, value_name = "FILE")]
     pub plot: Option<PathBuf>,
@@ -189,6 +290,7 @@ pub fn predict(a: &PredictArgs) -> anyhow::Result<ExitCode> {
         mass_budget_kg: a.mass_budget,
         reference,
         confidence: a.confidence,
+        speed_kind: a.speed_kind,
     };
     let pred = p::predict(&table, class, &req)?;
     let torque = match a.from.as_deref().and_then(|r| r.strip_prefix("design:")) {
@@ -228,9 +330,12 @@ pub struct TestCommon {
     /// Explanatory variable: leg_length, body_length or mass.
     #[arg(long, default_value = "leg_length")]
     pub x: String,
-    /// Response variable: leg_length, body_length or mass.
+    /// Response variable: leg_length, body_length, mass or speed (of --speed-kind).
     #[arg(long, default_value = "mass")]
     pub y: String,
+    /// Which speeds `--y speed` uses: top, typical, walking, running or unstated.
+    #[arg(long, value_enum, default_value_t)]
+    pub speed_kind: robot_survey::dataset::SpeedKind,
     /// Line-fitting method.
     #[arg(long, value_enum, default_value_t)]
     pub method: MethodArg,
@@ -244,16 +349,18 @@ pub struct TestCommon {
 
 #[derive(clap::Subcommand, Debug)]
 pub enum TestCommand {
-    /// Is the exponent of one class equal to VALUE (default: isometry, 3 for mass vs length)?
+    /// Is the exponent of one class equal to VALUE? By default each exponent of the scaling
+    /// laws of y against leg length (dataset/laws/table1.toml; speed: 0.5, dynamic
+    /// similarity, and 0.25, the biological trend below the speed hump) and 0, no trend.
     Slope {
         #[command(flatten)]
         common: TestCommon,
         /// Class tested.
         #[arg(long, default_value = "lower-biped")]
         class: String,
-        /// Hypothesised exponent (default: isometric, 1 for length vs length, 3 for mass vs length).
-        #[arg(long)]
-        value: Option<f64>,
+        /// Hypothesised exponents, comma separated (default: the scaling laws' and 0).
+        #[arg(long, value_delimiter = ',', allow_negative_numbers = true)]
+        value: Vec<f64>,
     },
     /// Do the classes share one exponent? Then: do they differ in elevation (a shift)?
     #[command(alias = "elevation")]
@@ -266,11 +373,6 @@ pub enum TestCommand {
     },
 }
 
-fn parse_var(s: &str) -> anyhow::Result<table2::Var> {
-    table2::Var::parse(s)
-        .with_context(|| format!("unknown variable `{s}` (one of: leg_length, body_length, mass)"))
-}
-
 pub fn test(a: &TestArgs) -> anyhow::Result<ExitCode> {
     use robot_survey::analysis::inference;
     let common = match &a.test {
@@ -278,16 +380,31 @@ pub fn test(a: &TestArgs) -> anyhow::Result<ExitCode> {
     };
     let ds = Dataset::locate(common.data.dataset.as_deref())?;
     let table = ds.table(common.data.release.as_deref())?;
-    let (x, y) = (parse_var(&common.x)?, parse_var(&common.y)?);
+    let (x, y) = (
+        parse_var(&common.x, common.speed_kind)?,
+        parse_var(&common.y, common.speed_kind)?,
+    );
     let text = match &a.test {
         TestCommand::Slope { class, value, .. } => {
+            use robot_survey::analysis::relation::{Hypothesis, default_hypotheses};
+            let hypotheses = match value.as_slice() {
+                [] => default_hypotheses(&ds, x, y)?,
+                given => given
+                    .iter()
+                    .map(|&b| Hypothesis {
+                        b,
+                        label: format!("b = {b}"),
+                        rationale: None,
+                    })
+                    .collect(),
+            };
             let r = inference::slope(
                 &table,
                 parse_group(class)?,
                 x,
                 y,
                 common.method.into(),
-                *value,
+                &hypotheses,
                 common.confidence,
             )?;
             match common.format {

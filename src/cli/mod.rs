@@ -6,6 +6,7 @@ mod dataset_cmd;
 mod diff_cmd;
 mod fit_cmd;
 mod gap;
+mod gap_benchmark;
 mod sim;
 mod study;
 

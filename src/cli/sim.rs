@@ -46,6 +46,94 @@ pub enum SimCommand {
     /// engine and compare with Drake's and the analytic values; compare every Drake walk
     /// golden with this engine's walk of the same design (both measured by this code).
     Crosscheck(CrosscheckArgs),
+    /// Write a design (scaled or not) as MJCF (MuJoCo), URDF or SDF (Drake): legs, hip,
+    /// feet, servo and start; what the format cannot carry goes to a sidecar TOML.
+    Export(ExportArgs),
+    /// Read a two-body hip walker from MJCF or URDF as a design TOML, every value tagged
+    /// with its source (the file and its sha256, --set, or the command's defaults).
+    Import(ImportArgs),
+    /// How fast this simulator walks a design: steps per second on one thread and on every
+    /// core, with the gait (tools/mujoco/bench.py runs it beside MuJoCo and Drake).
+    Bench(BenchArgs),
+}
+
+#[derive(Args, Debug)]
+#[command(
+    after_help = "Examples:\n  survey sim export --design mugatu --format mjcf --out mugatu.xml\n  \
+survey sim export --design mugatu --leg-length 1.0 --mass-law l2 --format urdf --out mugatu-1m.urdf\n\n\
+Writes FILE, FILE.sidecar.toml (the design values the format lacks: drive, start, the pressure-field \
+contact) and, for URDF/SDF of a design with section-cut feet, the feet as OBJ meshes beside it. \
+MuJoCo's contact is the closest soft contact to the pressure field (same bounce frequency and damping \
+ratio of the weight on one foot), not the same law; the command prints what differs."
+)]
+pub struct ExportArgs {
+    /// Design: a built-in name or a path to a design TOML.
+    #[arg(long, default_value = "mugatu")]
+    pub design: String,
+    /// Scale the design to this leg length [m] first.
+    #[arg(long, value_name = "M")]
+    pub leg_length: Option<f64>,
+    /// Mass law used when scaling.
+    #[arg(long, value_enum, default_value_t)]
+    pub mass_law: MassLaw,
+    /// Contact scaling rule.
+    #[arg(long, value_enum, default_value_t)]
+    pub contact: ContactScaling,
+    /// The format (default: from the extension of --out: .xml MJCF, .urdf, .sdf).
+    #[arg(long, value_enum)]
+    pub format: Option<robot_survey::interop::Format>,
+    /// The model file to write.
+    #[arg(long, value_name = "FILE")]
+    pub out: PathBuf,
+}
+
+#[derive(Args, Debug)]
+#[command(
+    after_help = "Examples:\n  survey sim import walker.urdf --out walker.toml\n  \
+survey sim import lab/mugatu.xml --set control.amplitude_deg=35 --set control.frequency_hz=1.4 --out mugatu-lab.toml\n\n\
+The file must be two legs joined by one revolute hip, the first leg free (links fixed to a leg are \
+merged into it); anything else is refused, saying what is missing. Each leg's foot is its lowest \
+collision geometry: a sphere or ellipsoid as it is, a mesh replaced by its best-fitting ellipsoid. \
+Values the file lacks (the drive, for instance) come from --set or the defaults, tagged as such."
+)]
+pub struct ImportArgs {
+    /// The robot file: MJCF (.xml) or URDF (.urdf).
+    pub file: PathBuf,
+    /// Write the design TOML here (default: print it).
+    #[arg(long, value_name = "FILE")]
+    pub out: Option<PathBuf>,
+    /// A design value: dotted path = number (or text for control.kind, contact.friction_cone).
+    #[arg(long = "set", value_name = "PATH=VALUE")]
+    pub set: Vec<String>,
+    /// The sidecar TOML of an export (its [design] values).
+    #[arg(long, value_name = "FILE")]
+    pub sidecar: Option<PathBuf>,
+    /// The design's name (default: the file's stem).
+    #[arg(long)]
+    pub name: Option<String>,
+}
+
+#[derive(Args, Debug)]
+#[command(
+    after_help = "Example:\n  survey sim bench --design mugatu-ref --duration 25 --walks 32 --format json\n\n\
+Times the unperturbed walk --repeats times on one thread (best and median) and --walks seeded walks \
+on --threads threads (default every core); steps counted to a fall. Build with --release to measure."
+)]
+pub struct BenchArgs {
+    #[command(flatten)]
+    pub run: RunArgs,
+    /// Scale the design to this leg length [m].
+    #[arg(long, value_name = "M")]
+    pub leg_length: Option<f64>,
+    /// Single-thread repeats.
+    #[arg(long, default_value_t = 5, value_parser = clap::value_parser!(u64).range(1..=1000))]
+    pub repeats: u64,
+    /// Walks of the batch.
+    #[arg(long, default_value_t = 16, value_parser = clap::value_parser!(u64).range(1..=100000))]
+    pub walks: u64,
+    /// Threads of the batch (default: every core).
+    #[arg(long)]
+    pub threads: Option<usize>,
 }
 
 #[derive(Args, Debug)]
@@ -83,6 +171,9 @@ pub struct CrosscheckArgs {
     /// Folder with cases.toml, elementary.json and walks/ (from tools/drake/).
     #[arg(long, value_name = "DIR", default_value = "tests/golden/drake")]
     pub golden: PathBuf,
+    /// Folder with MuJoCo's walks/ (from tools/mujoco/; skipped when absent).
+    #[arg(long, value_name = "DIR", default_value = "tests/golden/mujoco")]
+    pub mujoco_golden: PathBuf,
     /// Repository root the case and walk design paths are relative to.
     #[arg(long, value_name = "DIR", default_value = ".")]
     pub root: PathBuf,
@@ -176,7 +267,7 @@ pub struct ScaleArgs {
 #[derive(Args, Debug)]
 #[command(
     after_help = "Examples:\n  survey sim walk --design mugatu\n  survey sim walk --design zippy --leg-length 0.5 --mass-law l3 --format json\n  survey sim walk --design my-walker.toml --trajectory walk.csv --plot walk.svg\n\n\
-Built-in designs: mugatu, zippy, zippy-spherical (dataset/walkers/*.toml); a path to a TOML \
+Built-in designs: mugatu, zippy, zippy-spherical, mugatu-lab (dataset/walkers/*.toml); a path to a TOML \
 file of the same shape defines a new one. Scaling to --leg-length keeps dynamic similarity: \
 lengths ∝ L, mass ∝ L² or L³, inertia ∝ m·L², drive frequency ∝ L^(-1/2)."
 )]
@@ -210,7 +301,99 @@ pub fn run(a: &SimArgs) -> anyhow::Result<ExitCode> {
         SimCommand::Table3(t) => super::study::table3(t),
         SimCommand::Merge(m) => super::study::merge(m),
         SimCommand::Feet(f) => super::study::feet(f),
+        SimCommand::Export(e) => export(e),
+        SimCommand::Import(i) => import(i),
+        SimCommand::Bench(b) => bench(b),
     }
+}
+
+fn export(a: &ExportArgs) -> anyhow::Result<ExitCode> {
+    use robot_survey::interop::Format;
+    let format = match a.format {
+        Some(f) => f,
+        None => match a.out.extension().and_then(|e| e.to_str()) {
+            Some("xml") | Some("mjcf") => Format::Mjcf,
+            Some("urdf") => Format::Urdf,
+            Some("sdf") => Format::Sdf,
+            _ => anyhow::bail!(
+                "--out {}: give --format mjcf|urdf|sdf (the extension says none)",
+                a.out.display()
+            ),
+        },
+    };
+    let design = Design::resolve(&a.design)?;
+    let design = design.scaled(
+        a.leg_length.unwrap_or(design.geometry.leg_length_m),
+        a.mass_law,
+        a.contact,
+    )?;
+    let stem = a
+        .out
+        .file_name()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_else(|| "walker".into());
+    let e = robot_survey::interop::export(&design, format, &stem)?;
+    let dir = a.out.parent().unwrap_or(std::path::Path::new(""));
+    let sidecar = PathBuf::from(format!("{}.sidecar.toml", a.out.display()));
+    let mut files = Vec::new();
+    for (name, text) in &e.meshes {
+        let p = dir.join(name);
+        robot_survey::io::write_atomic(&p, text.as_bytes())?;
+        files.push(p.display().to_string());
+    }
+    robot_survey::io::write_atomic(&sidecar, e.sidecar.as_bytes())?;
+    robot_survey::io::write_atomic(&a.out, e.model.as_bytes())?;
+    files.push(sidecar.display().to_string());
+    files.push(a.out.display().to_string());
+    eprint!("{}", report::interop::export_text(&e, &files));
+    Ok(ExitCode::SUCCESS)
+}
+
+fn import(a: &ImportArgs) -> anyhow::Result<ExitCode> {
+    let mut set = Vec::new();
+    for s in &a.set {
+        let Some((k, v)) = s.split_once('=') else {
+            anyhow::bail!("--set {s}: expected PATH=VALUE, e.g. control.amplitude_deg=30");
+        };
+        set.push((k.trim().to_string(), v.trim().to_string()));
+    }
+    let opts = robot_survey::interop::ImportOptions {
+        set,
+        sidecar: a.sidecar.clone(),
+        name: a.name.clone(),
+    };
+    let imported = robot_survey::interop::import(&a.file, &opts)?;
+    match &a.out {
+        Some(p) => {
+            robot_survey::io::write_atomic(p, imported.toml.as_bytes())?;
+            eprint!("{}", report::interop::import_text(&imported));
+            eprintln!("wrote {}", p.display());
+        }
+        None => {
+            print(&imported.toml);
+            eprint!("{}", report::interop::import_text(&imported));
+        }
+    }
+    Ok(ExitCode::SUCCESS)
+}
+
+fn bench(a: &BenchArgs) -> anyhow::Result<ExitCode> {
+    let design = Design::resolve(&a.run.design)?;
+    let opts = robot_survey::study::bench::BenchOptions {
+        walk: WalkOptions {
+            leg_length_m: a.leg_length,
+            ..a.run.options()
+        },
+        repeats: a.repeats as usize,
+        batch_walks: a.walks as usize,
+        threads: a.threads,
+    };
+    let r = robot_survey::study::bench::bench(&design, &opts)?;
+    print(&match a.run.format {
+        SimFormat::Json => report::json(&r)?,
+        SimFormat::Text => report::interop::bench_text(&r),
+    });
+    Ok(ExitCode::SUCCESS)
 }
 
 fn min_torque(a: &MinTorqueArgs) -> anyhow::Result<ExitCode> {
@@ -237,7 +420,8 @@ fn min_torque(a: &MinTorqueArgs) -> anyhow::Result<ExitCode> {
 
 fn crosscheck(a: &CrosscheckArgs) -> anyhow::Result<ExitCode> {
     let spinner = Progress::Spinner(indicatif::ProgressBar::new_spinner());
-    let result = robot_survey::crosscheck::run(&a.root, &a.golden, &spinner)?;
+    let result =
+        robot_survey::crosscheck::run(&a.root, &a.golden, Some(&a.mujoco_golden), &spinner)?;
     spinner.clear();
     print(&match a.format {
         CrosscheckFormat::Json => report::json(&result)?,

@@ -19,6 +19,7 @@ use crate::progress::Observer;
 use crate::sim::{
     Controller, Design, FrictionCone, GRAVITY_MPS2, SimError, Simulator, State, WalkOptions,
     WalkReport, hip_frame_attitude, read_trajectory_csv, report_from_trajectory, simulate_walk,
+    upright_sinkage_m,
 };
 
 /// Errors of the cross-check (reading goldens, running cases).
@@ -153,25 +154,6 @@ pub fn case_design(root: &Path, case: &Case) -> Result<Design, CrosscheckError> 
     )?)
 }
 
-/// Depth at which one upright ellipsoid foot carries `load_n` under p = E(1 − r):
-/// (π/3)·E·a·b·(1 − r₀)²(1 + 2r₀) with r₀ = 1 − δ/c (bisection, as the harness).
-fn solve_sinkage(e: f64, semi: [f64; 3], load_n: f64) -> f64 {
-    let force = |d: f64| {
-        let r0 = (1.0 - d / semi[2]).max(0.0);
-        std::f64::consts::FRAC_PI_3 * e * semi[0] * semi[1] * (1.0 - r0).powi(2) * (1.0 + 2.0 * r0)
-    };
-    let (mut lo, mut hi) = (0.0, semi[2]);
-    for _ in 0..200 {
-        let mid = 0.5 * (lo + hi);
-        if force(mid) < load_n {
-            lo = mid;
-        } else {
-            hi = mid;
-        }
-    }
-    0.5 * (lo + hi)
-}
-
 /// Every step of a case: what the measurements need.
 #[derive(Default)]
 struct Trace {
@@ -258,7 +240,7 @@ fn run_trace(design: &Design, case: &Case) -> Result<(Trace, Design), Crosscheck
         "static" => {
             let semi = model.legs[0].foot_semi_axes_m;
             let load = model.total_mass_kg() * model.gravity_mps2.z.abs() / 2.0;
-            hip_z -= solve_sinkage(e, [semi.x, semi.y, semi.z], load);
+            hip_z -= upright_sinkage_m(e, [semi.x, semi.y, semi.z], load);
         }
         "touch" => {}
         other => {
@@ -660,6 +642,22 @@ pub struct WalkComparison {
     pub project_convex: Option<WalkReport>,
     /// Drake's trajectory measured by the project's gait metrics.
     pub drake: WalkReport,
+    /// MuJoCo's walk of the design's MJCF export (`tests/golden/mujoco/walks/` under the
+    /// same stem), measured by the same code; None where there is none.
+    pub mujoco: Option<WalkReport>,
+}
+
+/// A MuJoCo walk golden without a Drake twin (the bundled designs, whose section-cut feet
+/// Drake's harness refuses): the project's walk, with both friction cones, beside MuJoCo's.
+#[derive(Clone, Debug, Serialize)]
+pub struct PeerWalk {
+    pub name: String,
+    pub design: String,
+    pub leg_length_m: f64,
+    pub drive_frequency_hz: f64,
+    pub project: WalkReport,
+    pub project_convex: WalkReport,
+    pub mujoco: WalkReport,
 }
 
 /// The options a Drake walk golden was run with (walks/STEM.json `options`).
@@ -795,7 +793,51 @@ pub fn compare_walk(root: &Path, json_path: &Path) -> Result<WalkComparison, Cro
         project,
         project_convex,
         drake: g.drake,
+        mujoco: None,
     })
+}
+
+/// The project's walk beside a MuJoCo walk golden (STEM.json + STEM.csv, written by
+/// `tools/mujoco/harness.py`, the same JSON fields as Drake's).
+pub fn compare_peer_walk(root: &Path, json_path: &Path) -> Result<PeerWalk, CrosscheckError> {
+    let g = read_walk_golden(root, json_path)?;
+    let project = simulate_walk(&g.design, &g.options)?.report;
+    let mut d = g.design.clone();
+    d.contact.friction_cone = FrictionCone::Convex;
+    let project_convex = simulate_walk(&d, &g.options)?.report;
+    Ok(PeerWalk {
+        name: stem_of(json_path),
+        design: g.meta.design_file,
+        leg_length_m: project.leg_length_m,
+        drive_frequency_hz: project.drive_frequency_hz,
+        project,
+        project_convex,
+        mujoco: g.drake,
+    })
+}
+
+fn stem_of(p: &Path) -> String {
+    p.file_stem()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_default()
+}
+
+/// The walk goldens of a folder (STEM.json with a STEM.csv beside it), sorted.
+fn walk_goldens(dir: &Path) -> Result<Vec<PathBuf>, CrosscheckError> {
+    if !dir.is_dir() {
+        return Ok(Vec::new());
+    }
+    let mut files: Vec<PathBuf> = std::fs::read_dir(dir)
+        .map_err(|e| CrosscheckError::Read {
+            path: dir.to_path_buf(),
+            message: e.to_string(),
+        })?
+        .filter_map(Result::ok)
+        .map(|e| e.path())
+        .filter(|p| p.extension().is_some_and(|e| e == "json") && p.with_extension("csv").exists())
+        .collect();
+    files.sort();
+    Ok(files)
 }
 
 /// One measured quantity of an elementary case in both engines and, where one exists,
@@ -834,8 +876,11 @@ fn relative(ours: Option<f64>, drake: Option<f64>) -> Option<f64> {
 #[derive(Clone, Debug, Serialize)]
 pub struct Crosscheck {
     pub drake_version: Option<String>,
+    pub mujoco_version: Option<String>,
     pub elementary: Vec<QuantityRow>,
     pub walks: Vec<WalkComparison>,
+    /// MuJoCo walks of designs without a Drake golden.
+    pub mujoco_walks: Vec<PeerWalk>,
 }
 
 fn number(v: Option<&serde_json::Value>) -> Option<f64> {
@@ -844,11 +889,13 @@ fn number(v: Option<&serde_json::Value>) -> Option<f64> {
 
 /// Runs the project's side of every case in `golden/cases.toml` and every walk in
 /// `golden/walks/*.json`, beside Drake's and the analytic values from
-/// `golden/elementary.json`. `root` is the repository (design paths are relative to it);
-/// `progress` hears a stage ("running NAME") as each case or walk begins.
+/// `golden/elementary.json`, and every MuJoCo walk golden of `mujoco/walks/` (beside the
+/// Drake walk of the same stem, or on its own). `root` is the repository (design paths are
+/// relative to it); `progress` hears a stage ("running NAME") as each case or walk begins.
 pub fn run(
     root: &Path,
     golden: &Path,
+    mujoco: Option<&Path>,
     progress: &dyn Observer,
 ) -> Result<Crosscheck, CrosscheckError> {
     let cases = load_cases(&golden.join("cases.toml"))?;
@@ -879,28 +926,37 @@ pub fn run(
         }
     }
     let mut walks = Vec::new();
-    let dir = golden.join("walks");
-    if dir.is_dir() {
-        let mut files: Vec<PathBuf> = std::fs::read_dir(&dir)
-            .map_err(|e| CrosscheckError::Read {
-                path: dir.clone(),
-                message: e.to_string(),
-            })?
-            .filter_map(Result::ok)
-            .map(|e| e.path())
-            .filter(|p| {
-                p.extension().is_some_and(|e| e == "json") && p.with_extension("csv").exists()
-            })
-            .collect();
-        files.sort();
-        for f in files {
-            progress.stage(&format!("running {}", f.display()));
-            walks.push(compare_walk(root, &f)?);
+    let mujoco_dir = mujoco.map(|m| m.join("walks"));
+    let mujoco_files = match &mujoco_dir {
+        Some(d) => walk_goldens(d)?,
+        None => Vec::new(),
+    };
+    for f in walk_goldens(&golden.join("walks"))? {
+        progress.stage(&format!("running {}", f.display()));
+        let mut w = compare_walk(root, &f)?;
+        if let Some(m) = mujoco_files.iter().find(|m| stem_of(m) == w.name) {
+            w.mujoco = Some(read_walk_golden(root, m)?.drake);
         }
+        walks.push(w);
     }
+    let mut mujoco_walks = Vec::new();
+    for m in &mujoco_files {
+        if walks.iter().any(|w| w.name == stem_of(m)) {
+            continue;
+        }
+        progress.stage(&format!("running {}", m.display()));
+        mujoco_walks.push(compare_peer_walk(root, m)?);
+    }
+    let mujoco_version = mujoco_files
+        .first()
+        .and_then(|f| std::fs::read_to_string(f).ok())
+        .and_then(|t| serde_json::from_str::<serde_json::Value>(&t).ok())
+        .and_then(|v| v["engine"]["version"].as_str().map(str::to_string));
     Ok(Crosscheck {
         drake_version: drake["drake_version"].as_str().map(str::to_string),
+        mujoco_version,
         elementary: rows,
         walks,
+        mujoco_walks,
     })
 }

@@ -58,7 +58,7 @@ fn source_part(sources: &[String], parts: &mut Vec<String>) {
     }
 }
 
-/// A value as an inline table, keys in this order: value (or min, max), source, at,
+/// A value as an inline table, keys in this order: value (or min, max), source, at, gait,
 /// derived, derivation, note, history.
 fn datum(d: &Datum, ty: Option<FieldType>) -> String {
     let mut parts = Vec::new();
@@ -66,6 +66,9 @@ fn datum(d: &Datum, ty: Option<FieldType>) -> String {
     source_part(&d.sources, &mut parts);
     if let Some(a) = &d.at {
         parts.push(format!("at = {}", quote(a)));
+    }
+    if let Some(g) = &d.gait {
+        parts.push(format!("gait = {}", quote(g)));
     }
     if d.derived {
         parts.push("derived = true".into());

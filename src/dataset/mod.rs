@@ -33,7 +33,7 @@ use serde::{Deserialize, Serialize};
 pub use problem::{Problem, Rule, Severity};
 pub use record::{Datum, Robot, RobotClass, Source, SourceKind, Value};
 pub use release::{Manifest, SurveyRow, SurveyTable};
-pub use vocabulary::{FieldSpec, FieldType, Vocabulary};
+pub use vocabulary::{FieldSpec, FieldType, GaitSpec, SpeedKind, Vocabulary};
 
 /// The dataset directory compiled into the binary, so that `survey fit` works on a fresh
 /// machine from any working directory.

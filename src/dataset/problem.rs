@@ -47,6 +47,9 @@ pub enum Rule {
     Outlier,
     /// Values that contradict each other or physics (e.g. walking above the walk–run limit).
     Consistency,
+    /// A speed that does not say what kind of speed it is (top, typical, walking, running):
+    /// a warning in the live records, an error in a release from 1.5.0.
+    SpeedKind,
     /// A record is excluded from fits without a reason, or fitted without the fitted values.
     Exclusion,
     /// The file name does not match the record id.

@@ -13,7 +13,7 @@ use serde::Serialize;
 use super::release::{
     MANIFEST, Release, ReleaseFile, TABLE_CSV, TABLE_PARQUET, compile, parse_semver, sha256_hex,
 };
-use super::validate::validate;
+use super::validate::{as_release_problems, validate};
 use super::{Dataset, DatasetError};
 
 /// Today's date (UTC) as YYYY-MM-DD, from the system clock (civil-from-days, H. Hinnant).
@@ -99,11 +99,18 @@ pub fn cut_release(
             "CHANGELOG.md has no `## {version}` entry: describe what changed before releasing"
         )));
     }
-    let errors = validate(ds).errors();
+    // A release treats a speed of unstated kind as an error (a warning in the live records).
+    let problems = as_release_problems(validate(ds).problems);
+    let errors = super::problem::count(&problems, super::Severity::Error);
     if errors > 0 && !allow_errors {
+        let first = problems
+            .iter()
+            .find(|p| p.severity == super::Severity::Error)
+            .map(|p| format!(", first: {}", p.to_line()))
+            .unwrap_or_default();
         return Err(DatasetError::Other(format!(
-            "the live records have {errors} validation error(s); run `survey validate` and fix them first \
-             (or --allow-errors to freeze a published table with its known errors)"
+            "the live records have {errors} error(s) for a release{first}; run `survey validate` and fix them first \
+             (a speed of unstated kind is an error in a release; or --allow-errors to freeze a published table with its known errors)"
         )));
     }
     let note = if errors > 0 {

@@ -175,6 +175,9 @@ pub struct Datum {
     pub sources: Vec<String>,
     /// Where in the source the value is stated: page, table, section (`at = "Table I"`).
     pub at: Option<String>,
+    /// For a speed: the gait it was reached in (`walk`, `trot`, `run` …; see the
+    /// vocabulary's `[[gait]]` list), when the source says.
+    pub gait: Option<String>,
     /// The value is not stated directly but derived from what the source states
     /// (e.g. hip height = thigh + shank + foot height); `derivation` says how.
     pub derived: bool,
@@ -598,6 +601,13 @@ fn parse_value(
     };
     let at_key = text_key("at", problems);
     let derivation = text_key("derivation", problems);
+    let gait = text_key("gait", problems);
+    if gait.is_some() && spec.speed_kind.is_none() {
+        problems.push(at.problem(
+            Rule::UnknownField,
+            format!("`gait` applies to speeds (speed_*_mps fields) only, not to `{name}`"),
+        ));
+    }
     let derived = match t.get("derived") {
         None => false,
         Some(toml::Value::Boolean(b)) => *b,
@@ -618,6 +628,7 @@ fn parse_value(
         value,
         sources,
         at: at_key,
+        gait,
         derived,
         derivation,
         note,
@@ -756,12 +767,13 @@ fn parse_value_itself(
 }
 
 /// Keys a value may carry.
-pub const VALUE_KEYS: [&str; 9] = [
+pub const VALUE_KEYS: [&str; 10] = [
     "value",
     "min",
     "max",
     "source",
     "at",
+    "gait",
     "derived",
     "derivation",
     "note",

@@ -132,6 +132,32 @@ impl SurveyTable {
     pub fn fitted(&self) -> impl Iterator<Item = &SurveyRow> {
         self.rows.iter().filter(|r| r.fit)
     }
+
+    /// The same rows in another table's columns (cells of other columns dropped), with its
+    /// hash recomputed: a table compiled with today's vocabulary compared with a release
+    /// frozen under an older one, in the release's own columns.
+    pub fn in_columns(&self, columns: &[String]) -> SurveyTable {
+        let rows: Vec<SurveyRow> = self
+            .rows
+            .iter()
+            .map(|r| SurveyRow {
+                cells: r
+                    .cells
+                    .iter()
+                    .filter(|(c, _)| columns.contains(c))
+                    .map(|(c, v)| (c.clone(), v.clone()))
+                    .collect(),
+                ..r.clone()
+            })
+            .collect();
+        SurveyTable {
+            version: self.version.clone(),
+            frozen: self.frozen,
+            sha256: sha256_hex(&table_csv(columns, &rows)),
+            columns: columns.to_vec(),
+            rows,
+        }
+    }
 }
 
 fn table_csv(columns: &[String], rows: &[SurveyRow]) -> Vec<u8> {

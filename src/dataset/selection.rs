@@ -5,26 +5,71 @@
 
 use serde::Serialize;
 
-use super::{RobotClass, SurveyRow, SurveyTable};
+use super::{RobotClass, SpeedKind, SurveyRow, SurveyTable};
 use crate::regression;
 
-/// A survey variable, in the paper's words.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Serialize)]
+/// A survey variable, in the paper's words: the three sizes of Table 2 and the speeds,
+/// one variable per kind of speed (speeds of different kinds are not comparable).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash, Serialize)]
 #[serde(rename_all = "snake_case")]
 pub enum Var {
     LegLength,
     BodyLength,
     Mass,
+    SpeedTop,
+    SpeedTypical,
+    SpeedWalking,
+    SpeedRunning,
+    /// The survey's speeds of unstated kind (releases up to 1.4.0).
+    SpeedUnstated,
 }
 
 impl Var {
-    pub const ALL: [Var; 3] = [Var::LegLength, Var::BodyLength, Var::Mass];
+    pub const ALL: [Var; 8] = [
+        Var::LegLength,
+        Var::BodyLength,
+        Var::Mass,
+        Var::SpeedTop,
+        Var::SpeedTypical,
+        Var::SpeedWalking,
+        Var::SpeedRunning,
+        Var::SpeedUnstated,
+    ];
+    /// The sizes of Table 2: leg length, body length, mass.
+    pub const SIZES: [Var; 3] = [Var::LegLength, Var::BodyLength, Var::Mass];
+
+    /// The speed variable of a kind.
+    pub fn speed(kind: SpeedKind) -> Var {
+        match kind {
+            SpeedKind::Top => Var::SpeedTop,
+            SpeedKind::Typical => Var::SpeedTypical,
+            SpeedKind::Walking => Var::SpeedWalking,
+            SpeedKind::Running => Var::SpeedRunning,
+            SpeedKind::Unstated => Var::SpeedUnstated,
+        }
+    }
+    /// The kind of a speed variable (None for the sizes).
+    pub fn speed_kind(self) -> Option<SpeedKind> {
+        match self {
+            Var::LegLength | Var::BodyLength | Var::Mass => None,
+            Var::SpeedTop => Some(SpeedKind::Top),
+            Var::SpeedTypical => Some(SpeedKind::Typical),
+            Var::SpeedWalking => Some(SpeedKind::Walking),
+            Var::SpeedRunning => Some(SpeedKind::Running),
+            Var::SpeedUnstated => Some(SpeedKind::Unstated),
+        }
+    }
+    /// Position in [`Var::ALL`].
+    pub fn index(self) -> usize {
+        self as usize
+    }
     /// Column of the compiled table.
     pub fn field(self) -> &'static str {
         match self {
             Var::LegLength => "leg_length_m",
             Var::BodyLength => "body_length_m",
             Var::Mass => "mass_kg",
+            v => v.speed_kind().map(SpeedKind::field).unwrap_or_default(),
         }
     }
     pub fn as_str(self) -> &'static str {
@@ -32,25 +77,46 @@ impl Var {
             Var::LegLength => "leg_length",
             Var::BodyLength => "body_length",
             Var::Mass => "mass",
+            Var::SpeedTop => "speed_top",
+            Var::SpeedTypical => "speed_typical",
+            Var::SpeedWalking => "speed_walking",
+            Var::SpeedRunning => "speed_running",
+            Var::SpeedUnstated => "speed_unstated",
         }
     }
+    /// A variable by name (`mass`, `speed_top`) or column (`mass_kg`, `speed_top_mps`).
     pub fn parse(s: &str) -> Option<Var> {
         Var::ALL
             .into_iter()
             .find(|v| v.as_str() == s || v.field() == s)
     }
-    /// Symbol in the paper (L, L_B, m).
+    /// Symbol in the paper (L, L_B, m, v).
     pub fn symbol(self) -> &'static str {
         match self {
             Var::LegLength => "L",
             Var::BodyLength => "L_B",
             Var::Mass => "m",
+            _ => "v",
         }
     }
     pub fn unit(self) -> &'static str {
         match self {
             Var::LegLength | Var::BodyLength => "m",
             Var::Mass => "kg",
+            _ => "m/s",
+        }
+    }
+    /// The variable in words, for tables and axes ("top speed", "leg length").
+    pub fn label(self) -> &'static str {
+        match self {
+            Var::LegLength => "leg length",
+            Var::BodyLength => "body length",
+            Var::Mass => "mass",
+            Var::SpeedTop => "top speed",
+            Var::SpeedTypical => "typical speed",
+            Var::SpeedWalking => "walking speed",
+            Var::SpeedRunning => "running speed",
+            Var::SpeedUnstated => "speed of unstated kind",
         }
     }
 }

@@ -889,7 +889,9 @@ pub fn check(
 ) -> Result<ImportCheck, DatasetError> {
     let frozen = ds.table(Some(against))?;
     let robots: Vec<&Robot> = imp.robots.iter().collect();
-    let imported = super::release::compile_robots(&ds.vocab, &robots, against);
+    // In the release's own columns: the vocabulary has grown since (speed kinds, 1.5.0).
+    let imported =
+        super::release::compile_robots(&ds.vocab, &robots, against).in_columns(&frozen.columns);
     let mut differing = Vec::new();
     for r in &imported.rows {
         if frozen.rows.iter().find(|f| f.id == r.id) != Some(r) {

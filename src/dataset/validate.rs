@@ -27,6 +27,19 @@ pub const MASS_PER_LEG_CUBED: (f64, f64) = (1.0, 20_000.0);
 pub const WALK_FROUDE_LIMIT: f64 = 1.0;
 /// |externally studentized residual| above which a fitted robot is reported as an outlier.
 pub const OUTLIER_T: f64 = 3.0;
+/// The first release whose speeds must all state their kind: from it on a speed of
+/// unstated kind is an error in a release (it stays a warning in the live records).
+pub const SPEED_KIND_REQUIRED_FROM: (u64, u64, u64) = (1, 5, 0);
+
+/// The problems as a release must treat them: a speed of unstated kind, a warning in the
+/// live records, is an error in a release (cutting one, or checking the rows of one from
+/// [`SPEED_KIND_REQUIRED_FROM`] on).
+pub fn as_release_problems(mut problems: Vec<Problem>) -> Vec<Problem> {
+    for p in problems.iter_mut().filter(|p| p.rule == Rule::SpeedKind) {
+        p.severity = Severity::Error;
+    }
+    problems
+}
 
 /// The outcome of validation.
 #[derive(Debug, Clone, Serialize)]
@@ -158,13 +171,57 @@ fn check_record(
         };
         check_value(&mut c, name, d, spec);
         check_value_provenance(&mut c, name, d, spec);
+        check_speed_kind(&mut c, &ds.vocab, name, d, spec);
     }
     check_sources(&mut c);
     check_fit_status(&mut c, ds);
     check_definitions(&mut c);
     check_unit_slips(&mut c);
     check_class(&mut c);
-    check_froude(&mut c);
+    check_froude(&mut c, &ds.vocab);
+}
+
+/// A speed states its kind (by its field) and names a known gait, if any.
+fn check_speed_kind(
+    c: &mut RecordCheck,
+    vocab: &super::Vocabulary,
+    name: &str,
+    d: &Datum,
+    spec: &FieldSpec,
+) {
+    use Severity::{Error, Warning};
+    let field = format!("values.{name}");
+    if let Some(g) = &d.gait
+        && spec.speed_kind.is_some()
+        && vocab.gait(g).is_none()
+    {
+        c.push(
+            &field,
+            Error,
+            Rule::Range,
+            format!(
+                "unknown gait `{g}` (one of: {})",
+                vocab
+                    .gaits
+                    .iter()
+                    .map(|g| g.name.as_str())
+                    .collect::<Vec<_>>()
+                    .join(" | ")
+            ),
+        );
+    }
+    if spec.speed_kind == Some(super::SpeedKind::Unstated) {
+        let kinds: Vec<&str> = super::SpeedKind::STATED.iter().map(|k| k.field()).collect();
+        c.push(
+            &field,
+            Warning,
+            Rule::SpeedKind,
+            format!(
+                "`{name}` does not say what kind of speed it is: move it to the field of its kind ({}), with `gait` where the source says; an error in a release from 1.5.0",
+                kinds.join(", ")
+            ),
+        );
+    }
 }
 
 /// File name and id.
@@ -603,31 +660,51 @@ fn check_class(c: &mut RecordCheck) {
     }
 }
 
-/// Consistency with locomotion physics: walking above Froude 1 is impossible.
-fn check_froude(c: &mut RecordCheck) {
+/// Consistency with locomotion physics: walking above Froude 1 is impossible. A speed is
+/// taken as walking when its gait is a walking gait (the vocabulary's `walking = true`),
+/// when it is a walking speed with no gait stated, or — a speed of unstated kind — when
+/// a biped reports it and no faster running speed.
+fn check_froude(c: &mut RecordCheck, vocab: &super::Vocabulary) {
+    use super::SpeedKind;
     use Severity::Warning;
     let r = c.r;
-    let leg = r.number("leg_length_m");
-    if let Some(l) = leg {
-        for f in ["speed_walking_mps", "speed_normal_mps"] {
-            if let Some(v) = r.number(f) {
-                let fr = v * v / (G_MPS2 * l);
-                let running = r.number("speed_running_mps").is_some_and(|vr| vr >= v);
+    let Some(l) = r.number("leg_length_m") else {
+        return;
+    };
+    let biped = matches!(r.class, RobotClass::LowerBiped | RobotClass::FullBiped);
+    for (name, d) in &r.values {
+        let Some(kind) = vocab.get(name).and_then(|f| f.speed_kind) else {
+            continue;
+        };
+        let Some(v) = d.value.as_f64() else {
+            continue;
+        };
+        let gait = d.gait.as_deref().and_then(|g| vocab.gait(g));
+        let walking = match (gait, kind) {
+            (Some(g), _) => g.walking,
+            (None, SpeedKind::Walking) => true,
+            (None, SpeedKind::Unstated) => {
                 // A biped's "normal" speed is a walking speed; quadrupeds and hexapods
                 // normally trot, bound or run (Froude ≫ 1 for RHex-like runners is real).
-                let biped = matches!(r.class, RobotClass::LowerBiped | RobotClass::FullBiped);
-                let walking = f == "speed_walking_mps" || (biped && !running);
-                if fr > WALK_FROUDE_LIMIT && walking {
-                    c.push(
-                        &format!("values.{f}"),
-                        Warning,
-                        Rule::Consistency,
-                        format!(
-                            "{v} m/s on a {l} m leg is Froude number v²/(gL) = {fr:.2} > 1, beyond the walk–run limit: is it a running or top speed, or a unit slip?"
-                        ),
-                    );
-                }
+                biped && !r.number("speed_running_mps").is_some_and(|vr| vr >= v)
             }
+            (None, _) => false,
+        };
+        let fr = v * v / (G_MPS2 * l);
+        if walking && fr > WALK_FROUDE_LIMIT {
+            let what = match (gait, kind) {
+                (Some(g), _) => format!("in gait `{}`", g.name),
+                (None, SpeedKind::Unstated) => "(a speed of unstated kind)".to_string(),
+                (None, _) => format!("as a {kind} speed"),
+            };
+            c.push(
+                &format!("values.{name}"),
+                Warning,
+                Rule::Consistency,
+                format!(
+                    "{v} m/s {what} on a {l} m leg is Froude number v²/(gL) = {fr:.2} > 1, beyond the walk–run limit: is it a running or top speed in another gait, or a unit slip?"
+                ),
+            );
         }
     }
 }
@@ -1031,6 +1108,9 @@ pub fn validate_release_rows(
         Some((file.clone(), line))
     };
     push_outliers(&table, locate, "", &mut problems);
+    if parse_semver(version).is_some_and(|v| v >= SPEED_KIND_REQUIRED_FROM) {
+        problems = as_release_problems(problems);
+    }
     problems.sort_by(|a, b| {
         (a.severity, a.line, &a.field, a.rule).cmp(&(b.severity, b.line, &b.field, b.rule))
     });

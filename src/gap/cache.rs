@@ -11,11 +11,11 @@ use std::sync::atomic::{AtomicUsize, Ordering};
 use super::error::GapError;
 use super::knob::ModelSetting;
 use super::library::EffectLibrary;
-use super::simulate::{Condition, SimMetrics, simulate_jobs};
+use super::simulate::{Condition, Walked, simulate_jobs};
 use crate::progress::Observer;
 
-/// Walk metrics by (condition id, setting key).
-type WalkMap = HashMap<(usize, String), SimMetrics>;
+/// Walks by (condition id, setting key).
+type WalkMap = HashMap<(usize, String), Walked>;
 
 #[derive(Default)]
 pub struct SimCache {
@@ -31,19 +31,58 @@ impl SimCache {
         self.walks.load(Ordering::Relaxed)
     }
 
-    /// Metrics of `setting` on every condition, walking only what the cache lacks.
+    /// Walks of `setting` on every condition, walking only what the cache lacks.
     pub fn get(
         &self,
         conditions: &[Condition],
         lib: &EffectLibrary,
         setting: &ModelSetting,
         progress: &dyn Observer,
-    ) -> Result<Vec<SimMetrics>, GapError> {
+    ) -> Result<Vec<Walked>, GapError> {
         self.get_many(conditions, lib, std::slice::from_ref(setting), progress)
             .map(|mut v| v.remove(0))
     }
 
-    /// Metrics of several settings on every condition ([setting][condition]), the missing
+    /// Walks of `setting` on every condition from the start perturbed by `seed` (the design's
+    /// `initial.seed_*` table), walking only what the cache lacks.
+    pub fn get_from(
+        &self,
+        conditions: &[Condition],
+        lib: &EffectLibrary,
+        setting: &ModelSetting,
+        seed: u64,
+    ) -> Result<Vec<Walked>, GapError> {
+        use rayon::prelude::*;
+        let ids = self.condition_ids(conditions)?;
+        let keys: Vec<(usize, String)> = conditions
+            .iter()
+            .zip(&ids)
+            .map(|(c, id)| {
+                (
+                    *id,
+                    format!("{}#start{seed}", setting.key_for(&c.design.name)),
+                )
+            })
+            .collect();
+        let missing: Vec<usize> = {
+            let map = self.lock()?;
+            (0..conditions.len())
+                .filter(|i| !map.contains_key(&keys[*i]))
+                .collect()
+        };
+        let done: Vec<Walked> = missing
+            .par_iter()
+            .map(|&i| conditions[i].simulate_from(lib, setting, Some(seed)))
+            .collect::<Result<_, _>>()?;
+        self.walks.fetch_add(missing.len(), Ordering::Relaxed);
+        let mut map = self.lock()?;
+        for (i, w) in missing.into_iter().zip(done) {
+            map.insert(keys[i].clone(), w);
+        }
+        keys.iter().map(|k| cached(&map, k)).collect()
+    }
+
+    /// Walks of several settings on every condition ([setting][condition]), the missing
     /// walks in one parallel batch.
     pub fn get_many(
         &self,
@@ -51,7 +90,7 @@ impl SimCache {
         lib: &EffectLibrary,
         settings: &[ModelSetting],
         progress: &dyn Observer,
-    ) -> Result<Vec<Vec<SimMetrics>>, GapError> {
+    ) -> Result<Vec<Vec<Walked>>, GapError> {
         let ids = self.condition_ids(conditions)?;
         let keys: Vec<Vec<(usize, String)>> = settings
             .iter()
@@ -84,56 +123,7 @@ impl SimCache {
             map.insert(k, m);
         }
         keys.iter()
-            .map(|ks| {
-                ks.iter()
-                    .map(|k| {
-                        map.get(k)
-                            .copied()
-                            .ok_or_else(|| GapError::Invalid("cache miss after simulation".into()))
-                    })
-                    .collect()
-            })
-            .collect()
-    }
-
-    /// Metrics of `setting` on the conditions `which` (indices into `conditions`), in that
-    /// order, walking only what the cache lacks.
-    pub fn get_at(
-        &self,
-        conditions: &[Condition],
-        which: &[usize],
-        lib: &EffectLibrary,
-        setting: &ModelSetting,
-        progress: &dyn Observer,
-    ) -> Result<Vec<SimMetrics>, GapError> {
-        let ids = self.condition_ids(conditions)?;
-        let keys: Vec<(usize, String)> = which
-            .iter()
-            .map(|i| (ids[*i], setting.key_for(&conditions[*i].design.name)))
-            .collect();
-        let (missing_at, missing): (Vec<usize>, Vec<(usize, String)>) = {
-            let map = self.lock()?;
-            which
-                .iter()
-                .zip(&keys)
-                .filter(|(_, k)| !map.contains_key(*k))
-                .map(|(i, k)| (*i, k.clone()))
-                .unzip()
-        };
-        let jobs: Vec<(usize, ModelSetting)> =
-            missing_at.iter().map(|i| (*i, setting.clone())).collect();
-        let done = simulate_jobs(&jobs, conditions, lib, progress)?;
-        self.walks.fetch_add(jobs.len(), Ordering::Relaxed);
-        let mut map = self.lock()?;
-        for (k, m) in missing.into_iter().zip(done) {
-            map.insert(k, m);
-        }
-        keys.iter()
-            .map(|k| {
-                map.get(k)
-                    .copied()
-                    .ok_or_else(|| GapError::Invalid("cache miss after simulation".into()))
-            })
+            .map(|ks| ks.iter().map(|k| cached(&map, k)).collect())
             .collect()
     }
 
@@ -152,6 +142,13 @@ impl SimCache {
     fn lock(&self) -> Result<std::sync::MutexGuard<'_, WalkMap>, GapError> {
         locked(&self.map)
     }
+}
+
+/// The walk the cache holds under `key` (just simulated, if it was missing).
+fn cached(map: &WalkMap, key: &(usize, String)) -> Result<Walked, GapError> {
+    map.get(key)
+        .cloned()
+        .ok_or_else(|| GapError::Invalid("cache miss after simulation".into()))
 }
 
 /// A lock of the cache's, or the error a panicked worker leaves.

@@ -20,7 +20,7 @@ use std::path::Path;
 
 use serde::Deserialize;
 
-use super::error::GapError;
+use super::error::{GapError, read_text};
 use crate::sim::design::Design;
 
 /// Fraction of the way from the file's value to the farther range end of a declared error.
@@ -74,7 +74,7 @@ impl BenchmarkCases {
         let bundled = crate::dataset::bundled_dir("benchmarks")
             .and_then(|d| d.get_file(format!("benchmarks/{file}")))
             .and_then(|f| f.contents_utf8());
-        let design = resolve(design_name)?;
+        let design = resolve_design(design_name)?;
         match bundled {
             Some(text) => Self::parse(text, &format!("dataset/benchmarks/{file}"), &design),
             None => Self::derived(&design),
@@ -83,20 +83,18 @@ impl BenchmarkCases {
 
     /// A cases file given by the user, checked against the design.
     pub fn read(path: &Path, design_name: &str) -> Result<BenchmarkCases, GapError> {
-        let text = std::fs::read_to_string(path).map_err(|source| GapError::Read {
-            path: path.to_path_buf(),
-            source,
-        })?;
-        Self::parse(&text, &path.display().to_string(), &resolve(design_name)?)
+        let text = read_text(path)?;
+        Self::parse(
+            &text,
+            &path.display().to_string(),
+            &resolve_design(design_name)?,
+        )
     }
 
     /// Parses a cases file; every path must name a number of the design, and the design
     /// with each error's values set must be valid. Errors name the file and the entry.
     pub fn parse(text: &str, origin: &str, design: &Design) -> Result<BenchmarkCases, GapError> {
-        let bad = |message: String| GapError::File {
-            path: origin.to_string(),
-            message,
-        };
+        let bad = |message: String| GapError::file(origin, message);
         let file: CasesFile = toml::from_str(text).map_err(|e| bad(e.to_string()))?;
         let check = |table: &str, specs: Vec<ErrorSpec>| -> Result<Vec<ParameterError>, GapError> {
             specs
@@ -134,12 +132,9 @@ impl BenchmarkCases {
     /// Cases derived from a design's declarations (module docs). The compound error is the
     /// first undeclared one (an undeclared error beside every effect), if the design has any.
     pub fn derived(design: &Design) -> Result<BenchmarkCases, GapError> {
-        let sim = |source| GapError::Sim {
-            origin: design.name.clone(),
-            source,
-        };
+        let sim = GapError::sim(&design.name);
         let mut parameter_errors = Vec::new();
-        for u in design.uncertain_params().map_err(sim)? {
+        for u in design.uncertain_params().map_err(&sim)? {
             let toward = |end: f64| {
                 if u.log && u.nominal > 0.0 && end > 0.0 {
                     u.nominal * (end / u.nominal).powf(DECLARED_SHIFT)
@@ -167,7 +162,7 @@ impl BenchmarkCases {
             }
         }
         let mut undeclared = Vec::new();
-        for u in design.undeclared_params().map_err(sim)? {
+        for u in design.undeclared_params().map_err(&sim)? {
             let value = if u.nominal != 0.0 {
                 six_digits(u.nominal * UNDECLARED_FACTOR)
             } else {
@@ -196,9 +191,7 @@ fn six_digits(x: f64) -> f64 {
     format!("{x:.5e}").parse().unwrap_or(x)
 }
 
-fn resolve(design_name: &str) -> Result<Design, GapError> {
-    Design::resolve(design_name).map_err(|source| GapError::Sim {
-        origin: design_name.to_string(),
-        source,
-    })
+/// A bundled design by name, or a design file.
+pub fn resolve_design(design_name: &str) -> Result<Design, GapError> {
+    Design::resolve(design_name).map_err(GapError::sim(design_name))
 }

@@ -16,12 +16,13 @@ use rand_chacha::ChaCha8Rng;
 use serde::Serialize;
 
 use super::cache::SimCache;
-use super::diagnose::{designs_of, measured};
-use super::error::GapError;
+use super::diagnose::designs_of;
+use super::error::{GapError, check_default_sd};
 use super::knob::{KnobKind, Knobs};
 use super::library::EffectLibrary;
-use super::problem::{Observation, chi2_of};
-use super::simulate::{Condition, SimMetrics};
+use super::likelihood::{Observation, chi2_of};
+use super::observe::{fill_from_trajectories, metric_observations};
+use super::simulate::{Condition, Walked};
 use super::trials::{Metric, TrialSet};
 use crate::progress::Observer;
 use crate::regression::dist::chi2_upper_p;
@@ -176,13 +177,16 @@ pub fn explore(
     if opts.samples < 2 {
         return Err(GapError::Invalid("explore needs at least 2 samples".into()));
     }
-    let (filled, obs, mut notes) = measured(set, conditions, lib, opts.default_relative_sd)?;
-    let set = &filled;
+    check_default_sd(opts.default_relative_sd)?;
+    let set = &fill_from_trajectories(set, conditions, lib)?;
+    let mut notes = Vec::new();
+    let obs = metric_observations(set, opts.default_relative_sd, &mut notes);
+    if obs.is_empty() {
+        let why = "no trial has a measured metric the simulator computes";
+        return Err(GapError::file(&set.origin, why));
+    }
     let designs = designs_of(conditions);
-    let knobs = Knobs::build(&designs, &[], true).map_err(|e| GapError::Sim {
-        origin: set.origin.clone(),
-        source: e,
-    })?;
+    let knobs = Knobs::build(&designs, &[], true).map_err(GapError::sim(&set.origin))?;
     let params: Vec<usize> = (0..knobs.len())
         .filter(|i| knobs.list[*i].kind == KnobKind::Parameter)
         .collect();
@@ -201,44 +205,24 @@ pub fn explore(
     settings.extend(points.iter().map(|p| knobs.setting(lib, p)));
     let walks_before = cache.walks();
     let sims = cache.get_many(conditions, lib, &settings, progress)?;
-    let nominal_chi2 = chi2_of(&obs, &sims[0]).0;
+    let nominal_chi2 = chi2_of(&obs, &sims[0]);
     let n_obs = obs.len();
+    let p_of = |chi2: f64| chi2_upper_p(chi2, n_obs as f64).unwrap_or(0.0);
+    let fell = |s: &[Walked]| s.iter().any(|m| m.metrics.fell);
 
     let sample_sims = &sims[1..];
-    let fell: Vec<bool> = sample_sims
+    let chi2: Vec<f64> = sample_sims.iter().map(|s| chi2_of(&obs, s)).collect();
+    let plausible: Vec<bool> = sample_sims
         .iter()
-        .map(|s| s.iter().any(|m| m.fell))
-        .collect();
-    let chi2: Vec<f64> = sample_sims.iter().map(|s| chi2_of(&obs, s).0).collect();
-    let plausible: Vec<bool> = chi2
-        .iter()
-        .zip(&fell)
-        .map(|(c, f)| !f && chi2_upper_p(*c, n_obs as f64).unwrap_or(0.0) >= PLAUSIBLE_P)
+        .zip(&chi2)
+        .map(|(s, c)| !fell(s) && p_of(*c) >= PLAUSIBLE_P)
         .collect();
     let best = (0..chi2.len())
         .min_by(|a, b| chi2[*a].total_cmp(&chi2[*b]))
         .ok_or_else(|| GapError::Invalid("no sample".into()))?;
-    let walking: Vec<usize> = (0..chi2.len()).filter(|i| !fell[*i]).collect();
-    if chi2[best] > nominal_chi2 {
-        notes.push(format!(
-            "every sampled setting fits worse than the file's values (best χ² {:.1} > nominal \
-             {:.1}): {} samples over {} parameters are too sparse for these trials; run \
-             `survey gap diagnose` (a local fit) or more samples before reading anything into \
-             \"no plausible setting\"",
-            chi2[best],
-            nominal_chi2,
-            opts.samples,
-            params.len()
-        ));
-    }
-    if walking.len() < opts.samples {
-        notes.push(format!(
-            "{} of {} settings fell on some condition (χ² charged as a fall)",
-            opts.samples - walking.len(),
-            opts.samples
-        ));
-    }
-
+    let walking: Vec<usize> = (0..chi2.len())
+        .filter(|i| !fell(&sample_sims[*i]))
+        .collect();
     let samples = Samples {
         units: &units,
         points: &points,
@@ -247,9 +231,9 @@ pub fn explore(
         walking: &walking,
         best,
     };
+    samples.notes(nominal_chi2, &mut notes);
     let parameters = samples.parameters(&knobs, &params);
     let metrics = samples.metrics(&obs, set, sample_sims, &sims[0]);
-
     Ok(Exploration {
         origin: set.origin.clone(),
         samples: opts.samples,
@@ -258,11 +242,10 @@ pub fn explore(
         fell: opts.samples - walking.len(),
         plausible: plausible.iter().filter(|p| **p).count(),
         nominal_chi2,
-        nominal_plausible: !sims[0].iter().any(|m| m.fell)
-            && chi2_upper_p(nominal_chi2, n_obs as f64).unwrap_or(0.0) >= PLAUSIBLE_P,
+        nominal_plausible: !fell(&sims[0]) && p_of(nominal_chi2) >= PLAUSIBLE_P,
         too_sparse: chi2[best] > nominal_chi2,
         best_chi2: chi2[best],
-        best_p: chi2_upper_p(chi2[best], n_obs as f64).unwrap_or(0.0),
+        best_p: p_of(chi2[best]),
         parameters,
         metrics,
         walks: cache.walks() - walks_before,
@@ -284,6 +267,27 @@ struct Samples<'a> {
 }
 
 impl Samples<'_> {
+    /// Notes on a sample too sparse for the trials (every setting fits worse than the file's
+    /// values, χ² `nominal_chi2`) and on settings that fell.
+    fn notes(&self, nominal_chi2: f64, notes: &mut Vec<String>) {
+        let (samples, best) = (self.units.len(), self.chi2[self.best]);
+        if best > nominal_chi2 {
+            notes.push(format!(
+                "every sampled setting fits worse than the file's values (best χ² {best:.1} > \
+                 nominal {nominal_chi2:.1}): {samples} samples over {} parameters are too sparse \
+                 for these trials; run `survey gap diagnose` (a local fit) or more samples \
+                 before reading anything into \"no plausible setting\"",
+                self.units.first().map_or(0, Vec::len)
+            ));
+        }
+        if self.walking.len() < samples {
+            notes.push(format!(
+                "{} of {samples} settings fell on some condition (χ² charged as a fall)",
+                samples - self.walking.len()
+            ));
+        }
+    }
+
     /// Each parameter's reach: its plausible range, best value and the rank correlation of
     /// its coordinate with χ² over the walking samples.
     fn parameters(&self, knobs: &Knobs, params: &[usize]) -> Vec<ParameterReach> {
@@ -336,58 +340,30 @@ impl Samples<'_> {
         &self,
         obs: &[Observation],
         set: &TrialSet,
-        sample_sims: &[Vec<SimMetrics>],
-        nominal: &[SimMetrics],
+        sample_sims: &[Vec<Walked>],
+        nominal: &[Walked],
     ) -> Vec<MetricReach> {
         obs.iter()
             .map(|o: &Observation| {
                 let vals: Vec<f64> = self
                     .walking
                     .iter()
-                    .map(|w| sample_sims[*w][o.trial].get(o.metric))
+                    .map(|w| sample_sims[*w][o.trial].channel(o.channel))
                     .filter(|v| v.is_finite())
                     .collect();
                 let lo = vals.iter().copied().fold(f64::INFINITY, f64::min);
                 let hi = vals.iter().copied().fold(f64::NEG_INFINITY, f64::max);
                 MetricReach {
                     trial: set.trials[o.trial].label.clone(),
-                    metric: o.metric,
+                    metric: o.as_metric().unwrap_or(super::trials::Metric::VelocityMps),
                     measured: o.value,
                     sd: o.sd,
-                    nominal: nominal[o.trial].get(o.metric),
+                    nominal: nominal[o.trial].channel(o.channel),
                     reach: [lo, hi],
-                    best: sample_sims[self.best][o.trial].get(o.metric),
+                    best: sample_sims[self.best][o.trial].channel(o.channel),
                     reachable: lo - 2.0 * o.sd <= o.value && o.value <= hi + 2.0 * o.sd,
                 }
             })
             .collect()
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn latin_hypercube_fills_every_stratum_once() {
-        let n = 17;
-        let pts = latin_hypercube(n, 3, 9);
-        assert_eq!(pts.len(), n);
-        for d in 0..3 {
-            let mut strata: Vec<usize> = pts.iter().map(|p| (p[d] * n as f64) as usize).collect();
-            strata.sort();
-            assert_eq!(strata, (0..n).collect::<Vec<_>>(), "coordinate {d}");
-        }
-        assert_eq!(pts, latin_hypercube(n, 3, 9), "deterministic in the seed");
-    }
-
-    #[test]
-    fn spearman_matches_hand_values() {
-        // Monotone: +1 / −1 whatever the spacing.
-        assert!((spearman(&[1.0, 2.0, 3.0, 4.0], &[1.0, 10.0, 100.0, 1000.0]) - 1.0).abs() < 1e-12);
-        assert!((spearman(&[1.0, 2.0, 3.0, 4.0], &[4.0, 3.0, 1.0, 0.5]) + 1.0).abs() < 1e-12);
-        // Ranks x = 1..5, y = (2,1,4,3,5): Σd² = 4, ρ = 1 − 6·4/(5·24) = 0.8.
-        let r = spearman(&[1.0, 2.0, 3.0, 4.0, 5.0], &[2.0, 1.0, 4.0, 3.0, 5.0]);
-        assert!((r - 0.8).abs() < 1e-12, "{r}");
     }
 }

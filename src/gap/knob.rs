@@ -4,8 +4,11 @@
 //! nominal value (parameters) or off (effects). A *point* gives every free knob a value.
 //!
 //! Each knob has a coordinate: its value, or ln(value) for effect magnitudes and log-scale
-//! parameters, bounded by its plausible range. Parameters may carry a Gaussian prior
-//! (the design's `sd` or `relative_sd`), charged as ((value − nominal)/sd)² in the χ².
+//! parameters, bounded by its plausible range. A knob's prior over that range is uniform in
+//! its coordinate (log-uniform for effects and `log = true` parameters), or the design's
+//! Gaussian (`sd` or `relative_sd`) truncated to the range. The design's other numbers
+//! (undeclared: not in its `[[uncertain]]`) are knobs too, over ×/÷ 2 around their value
+//! ([`crate::sim::Design::undeclared_params`]).
 
 use serde::Serialize;
 
@@ -19,6 +22,8 @@ pub enum KnobKind {
     Parameter,
     /// An effect of the library (unmodelled physics).
     Effect,
+    /// A number of a design that its file does not declare uncertain.
+    Undeclared,
 }
 
 #[derive(Clone, Debug, Serialize)]
@@ -71,12 +76,43 @@ impl Knob {
         }
     }
 
+    /// An undeclared number of a design, weighed over the range the audit gives it.
+    pub fn undeclared(design: &str, u: &crate::sim::design::UncertainParam) -> Knob {
+        Knob {
+            kind: KnobKind::Undeclared,
+            ..Knob::parameter(design, u)
+        }
+    }
+
     /// A readable name: the effect's, or `design:path` for a parameter.
     pub fn label(&self) -> String {
         match self.kind {
             KnobKind::Effect => self.name.clone(),
-            KnobKind::Parameter => format!("{}:{}", self.design, self.name),
+            KnobKind::Parameter | KnobKind::Undeclared => format!("{}:{}", self.design, self.name),
         }
+    }
+
+    /// A design's number (declared or not), as opposed to an effect.
+    pub fn is_parameter(&self) -> bool {
+        self.kind != KnobKind::Effect
+    }
+
+    /// The log density of the knob's prior at unit coordinate `s` ∈ [0, 1] (uniform: 0; a
+    /// Gaussian prior in value units, truncated to the range, carried into unit
+    /// coordinates: N(v; mean, sd) · |dv/ds| / its mass over the range).
+    pub fn log_prior_unit(&self, s: f64) -> f64 {
+        let Some((mean, sd)) = self.prior else {
+            return 0.0;
+        };
+        let x = self.from_unit(s);
+        let v = self.value(x);
+        let dv_dx = if self.log { v } else { 1.0 };
+        let cdf = |v: f64| crate::regression::dist::normal_cdf((v - mean) / sd).unwrap_or(0.5);
+        let mass = cdf(self.value(self.hi)) - cdf(self.value(self.lo));
+        let z = (v - mean) / sd;
+        -0.5 * z * z - (sd * (2.0 * std::f64::consts::PI).sqrt()).ln()
+            + (dv_dx * (self.hi - self.lo)).abs().ln()
+            - mass.max(f64::MIN_POSITIVE).ln()
     }
 
     /// Value (the field's unit; nondimensional magnitude for effects) of a coordinate.
@@ -113,16 +149,6 @@ impl Knob {
         })
     }
 
-    /// The prior's χ² charge of a coordinate (0 without a prior).
-    pub fn prior_chi2(&self, x: f64) -> f64 {
-        self.prior_z(x).map_or(0.0, |z| z.powi(2))
-    }
-
-    /// The prior's signed residual (value − mean) / sd at coordinate `x`, if it has one.
-    pub fn prior_z(&self, x: f64) -> Option<f64> {
-        self.prior.map(|(mean, sd)| (self.value(x) - mean) / sd)
-    }
-
     /// Coordinates from the nominal (or off) toward the strongest setting: up from an off
     /// value of 0 (or below the range), down from ∞ (or above), and from an off value inside
     /// the range toward the lower end (for μ: slipperier). Parameters: toward the farther end.
@@ -133,7 +159,7 @@ impl Knob {
             }
             (KnobKind::Effect, _, None) => (self.lo, self.hi),
             (KnobKind::Effect, _, Some(x)) => (x, self.lo),
-            (KnobKind::Parameter, _, x) => {
+            (KnobKind::Parameter | KnobKind::Undeclared, _, x) => {
                 let x = x.unwrap_or(self.lo);
                 if self.hi - x >= x - self.lo {
                     (x, self.hi)
@@ -168,13 +194,6 @@ pub struct ModelSetting {
 impl ModelSetting {
     pub fn nominal() -> ModelSetting {
         ModelSetting::default()
-    }
-
-    pub fn effect(e: EffectSetting) -> ModelSetting {
-        ModelSetting {
-            params: Vec::new(),
-            effects: vec![e],
-        }
     }
 
     /// The overrides that apply to design `design`.
@@ -285,6 +304,34 @@ impl Knobs {
         Ok(Knobs { list, aliased })
     }
 
+    /// These knobs and, after them, every undeclared number of `designs` that no knob
+    /// already frees and no candidate effect stands for (`soft_ground` replaces the contact
+    /// modulus: the same physics, already weighed).
+    pub fn with_undeclared(
+        mut self,
+        designs: &[&Design],
+        lib: &EffectLibrary,
+    ) -> Result<Knobs, crate::sim::SimError> {
+        let replaced: Vec<String> = self
+            .list
+            .iter()
+            .filter(|k| k.kind == KnobKind::Effect)
+            .filter_map(|k| lib.get(&k.name).ok().and_then(|d| d.replaces.clone()))
+            .collect();
+        for d in designs {
+            for u in d.undeclared_params()? {
+                let freed = self
+                    .list
+                    .iter()
+                    .any(|k| k.is_parameter() && k.design == d.name && k.name == u.path);
+                if !freed && !replaced.contains(&u.path) {
+                    self.list.push(Knob::undeclared(&d.name, &u));
+                }
+            }
+        }
+        Ok(self)
+    }
+
     pub fn len(&self) -> usize {
         self.list.len()
     }
@@ -312,7 +359,7 @@ impl Knobs {
                 continue;
             }
             match k.kind {
-                KnobKind::Parameter => {
+                KnobKind::Parameter | KnobKind::Undeclared => {
                     s.params
                         .push((k.design.clone(), k.name.clone(), k.value(x)));
                 }
@@ -326,6 +373,21 @@ impl Knobs {
         s
     }
 
+    /// The setting with the knobs of `set` at their coordinates and the others nominal.
+    pub fn setting_at(&self, lib: &EffectLibrary, set: &[(usize, f64)]) -> ModelSetting {
+        let mut p = self.nominal_point();
+        for &(k, x) in set {
+            p[k] = Some(x);
+        }
+        self.setting(lib, &p)
+    }
+
+    /// The (knob, coordinate) pairs of the knobs `free` at unit coordinates `unit`.
+    pub fn set_of(&self, free: &[usize], unit: &[f64]) -> Vec<(usize, f64)> {
+        let at = |(&k, &s): (&usize, &f64)| (k, self.list[k].from_unit(s));
+        free.iter().zip(unit).map(at).collect()
+    }
+
     /// `base` with the knobs `active` set from unit coordinates `unit` (what the solvers
     /// see) to values.
     pub fn point_at(&self, base: &[Option<f64>], active: &[usize], unit: &[f64]) -> Point {
@@ -334,61 +396,5 @@ impl Knobs {
             p[k] = Some(self.list[k].from_unit(s));
         }
         p
-    }
-
-    /// The prior's χ² charge of a point.
-    pub fn prior_chi2(&self, point: &[Option<f64>]) -> f64 {
-        self.list
-            .iter()
-            .zip(point)
-            .filter_map(|(k, x)| x.map(|x| k.prior_chi2(x)))
-            .sum()
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-    use crate::gap::library::EffectLibrary;
-
-    /// The knobs of the bundled Mugatu: its declared parameters (nominal inside the range),
-    /// then the effects — damping (off = 0) strengthening upward, the motor line (off = ∞)
-    /// downward — and friction_coefficient left out because the design calibrates μ.
-    #[test]
-    fn mugatu_knobs_and_their_directions() {
-        let lib = EffectLibrary::bundled().expect("library");
-        let d = Design::builtin("mugatu").expect("mugatu");
-        let effects: Vec<&EffectDef> = lib.effects.iter().collect();
-        let k = Knobs::build(&[&d], &effects, true).expect("knobs");
-        let n_params = d.uncertain.len();
-        assert!(
-            k.list[..n_params]
-                .iter()
-                .all(|x| x.kind == KnobKind::Parameter)
-        );
-        assert_eq!(
-            k.aliased,
-            vec![(
-                "friction_coefficient".to_string(),
-                "contact.friction_mu".to_string()
-            )]
-        );
-        let slope = &k.list[k.index_of("mugatu:ground.slope_deg").expect("slope")];
-        assert_eq!((slope.lo, slope.hi, slope.nominal), (-3.0, 3.0, Some(0.0)));
-        assert_eq!(slope.prior_chi2(2.0), 4.0, "sd 1 deg: 2 deg costs 2²");
-        let damping = &k.list[k.index_of("hip_viscous_damping").expect("damping")];
-        let path = damping.strengthening_path(4);
-        assert!(path[0] < path[4] && damping.nominal.is_none());
-        let motor = &k.list[k.index_of("motor_torque_speed").expect("motor")];
-        let path = motor.strengthening_path(4);
-        assert!(path[0] > path[4], "a slower motor is a stronger effect");
-        // Coordinates: ln for effects; a knob at its nominal is the nominal model.
-        assert!((damping.value(damping.coordinate(0.02)) - 0.02).abs() < 1e-15);
-        let mut p = k.nominal_point();
-        p[k.index_of("mugatu:ground.slope_deg").expect("slope")] = Some(0.0);
-        assert_eq!(k.setting(&lib, &p), ModelSetting::nominal());
-        let off = Knobs::build(&[&d], &effects, false).expect("no calibration");
-        assert!(off.list.iter().all(|x| x.kind == KnobKind::Effect));
-        assert!(off.aliased.is_empty(), "without calibration μ is an effect");
     }
 }

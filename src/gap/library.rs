@@ -7,12 +7,11 @@
 //! The first parameter is the effect's magnitude, the one the diagnosis fits; the others stay
 //! at their defaults.
 
-use std::collections::BTreeMap;
 use std::path::Path;
 
 use serde::{Deserialize, Serialize};
 
-use super::error::GapError;
+use super::error::{GapError, read_text};
 use crate::sim::{Design, EffectSpec, GRAVITY_MPS2};
 
 /// The natural unit a parameter is written in (its value for a design at 1×).
@@ -190,22 +189,13 @@ impl EffectLibrary {
 
     /// A library read from a folder of effect files.
     pub fn from_dir(dir: &Path) -> Result<EffectLibrary, GapError> {
-        let rd = std::fs::read_dir(dir).map_err(|source| GapError::Read {
-            path: dir.to_path_buf(),
-            source,
-        })?;
+        let rd = std::fs::read_dir(dir).map_err(GapError::read(dir))?;
         let mut files = Vec::new();
         for e in rd {
-            let e = e.map_err(|source| GapError::Read {
-                path: dir.to_path_buf(),
-                source,
-            })?;
+            let e = e.map_err(GapError::read(dir))?;
             let p = e.path();
             if p.extension().is_some_and(|x| x == "toml") {
-                let text = std::fs::read_to_string(&p).map_err(|source| GapError::Read {
-                    path: p.clone(),
-                    source,
-                })?;
+                let text = read_text(&p)?;
                 files.push((p.display().to_string(), text));
             }
         }
@@ -216,10 +206,8 @@ impl EffectLibrary {
     fn from_texts(files: &[(String, String)]) -> Result<EffectLibrary, GapError> {
         let mut effects = Vec::new();
         for (origin, text) in files {
-            let def: EffectDef = toml::from_str(text).map_err(|e| GapError::File {
-                path: origin.clone(),
-                message: e.to_string(),
-            })?;
+            let def: EffectDef =
+                toml::from_str(text).map_err(|e| GapError::file(origin, e.to_string()))?;
             def.check(origin)?;
             effects.push(def);
         }
@@ -260,10 +248,7 @@ impl EffectLibrary {
 
 impl EffectDef {
     fn check(&self, origin: &str) -> Result<(), GapError> {
-        let bad = |m: String| GapError::File {
-            path: origin.to_string(),
-            message: m,
-        };
+        let bad = |m: String| GapError::file(origin, m);
         if self.parameters.is_empty() {
             return Err(bad("an effect needs at least one parameter".into()));
         }
@@ -351,15 +336,6 @@ impl EffectDef {
                 })
                 .collect(),
         }
-    }
-
-    /// Parameter values in SI for design `d`, by name.
-    pub fn si_values(&self, d: &Design, nondimensional: &[f64]) -> BTreeMap<String, f64> {
-        self.parameters
-            .iter()
-            .zip(nondimensional)
-            .map(|(p, v)| (p.name.clone(), v * p.scale.value(d)))
-            .collect()
     }
 }
 

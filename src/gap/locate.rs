@@ -4,13 +4,18 @@
 
 use serde::Serialize;
 
-use super::problem::FELL_Z2;
+use super::likelihood::FELL_Z2;
 use super::trials::Metric;
 use crate::regression::dist::chi2_upper_p;
 use crate::regression::{Method, fit_line};
 
 fn chi2_sf(x: f64, df: f64) -> f64 {
     chi2_upper_p(x, df).unwrap_or(1.0)
+}
+
+/// A residual's z², a fall's [`FELL_Z2`].
+fn z2(r: &Residual) -> f64 {
+    r.z.map_or(FELL_Z2, |z| z * z)
 }
 
 /// A residual of the nominal (and, once a best effect is found, the corrected) simulation.
@@ -99,11 +104,7 @@ pub fn metric_gaps(res: &[Residual], alpha: f64) -> Vec<MetricGap> {
         if rs.is_empty() {
             continue;
         }
-        let z2: Vec<f64> = rs
-            .iter()
-            .map(|r| r.z.map(|z| z * z).unwrap_or(FELL_Z2))
-            .collect();
-        let chi2: f64 = z2.iter().sum();
+        let chi2: f64 = rs.iter().map(|r| z2(r)).sum();
         let nn = rs.len() as f64;
         let p_value = chi2_sf(chi2, nn);
         let rel: Vec<f64> = rs.iter().filter_map(|r| r.relative).collect();
@@ -112,11 +113,10 @@ pub fn metric_gaps(res: &[Residual], alpha: f64) -> Vec<MetricGap> {
         } else {
             rel.iter().sum::<f64>() / rel.len() as f64
         };
-        let ls: Vec<f64> = rs.iter().map(|r| r.leg_length_m).collect();
-        let (lmin, lmax) = ls
+        let (lmin, lmax) = rs
             .iter()
-            .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| {
-                (a.min(*v), b.max(*v))
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), r| {
+                (a.min(r.leg_length_m), b.max(r.leg_length_m))
             });
         let with_rel: Vec<&&Residual> = rs.iter().filter(|r| r.relative.is_some()).collect();
         let y: Vec<f64> = with_rel.iter().filter_map(|r| r.relative).collect();
@@ -126,86 +126,8 @@ pub fn metric_gaps(res: &[Residual], alpha: f64) -> Vec<MetricGap> {
         let rms_after = (after.len() == rs.len() && !after.is_empty())
             .then(|| (after.iter().map(|z| z * z).sum::<f64>() / nn).sqrt());
         let significant = p_value < alpha;
-        let mut keys: Vec<(String, String)> = rs
-            .iter()
-            .map(|r| (r.design.clone(), sig3(r.leg_length_m)))
-            .collect();
-        keys.sort();
-        keys.dedup();
-        let regimes: Vec<RegimeGap> = keys
-            .iter()
-            .map(|(dn, lk)| {
-                let g: Vec<&&Residual> = rs
-                    .iter()
-                    .filter(|r| &r.design == dn && &sig3(r.leg_length_m) == lk)
-                    .collect();
-                let c2: f64 = g
-                    .iter()
-                    .map(|r| r.z.map(|z| z * z).unwrap_or(FELL_Z2))
-                    .sum();
-                let rel: Vec<f64> = g.iter().filter_map(|r| r.relative).collect();
-                let p = chi2_sf(c2, g.len() as f64);
-                RegimeGap {
-                    design: dn.clone(),
-                    leg_length_m: g[0].leg_length_m,
-                    n: g.len(),
-                    rms_z: (c2 / g.len() as f64).sqrt(),
-                    mean_relative_pct: 100.0 * rel.iter().sum::<f64>() / rel.len().max(1) as f64,
-                    p_value: p,
-                    significant: p < alpha,
-                }
-            })
-            .collect();
-        let place = if (lmax / lmin - 1.0).abs() < 0.05 {
-            format!("at L ≈ {} m", sig3(lmin))
-        } else {
-            format!("over L = {}–{} m", sig3(lmin), sig3(lmax))
-        };
-        let hot: Vec<&RegimeGap> = regimes.iter().filter(|g| g.significant).collect();
-        let same_sign = (hot.iter().all(|g| g.mean_relative_pct < 0.0)
-            || hot.iter().all(|g| g.mean_relative_pct >= 0.0))
-            && regimes.iter().all(|g| g.design == regimes[0].design);
-        let statement = if significant
-            && regimes.len() > 1
-            && !hot.is_empty()
-            && !(hot.len() == regimes.len() && same_sign)
-        {
-            // Say where: the regimes that carry it.
-            let parts: Vec<String> = hot
-                .iter()
-                .map(|g| {
-                    format!(
-                        "{}-predicted by {:.0} % at L ≈ {} m ({})",
-                        if g.mean_relative_pct < 0.0 {
-                            "under"
-                        } else {
-                            "over"
-                        },
-                        g.mean_relative_pct.abs(),
-                        sig3(g.leg_length_m),
-                        g.design
-                    )
-                })
-                .collect();
-            let rest = if hot.len() < regimes.len() {
-                ", within noise elsewhere"
-            } else {
-                ""
-            };
-            format!("{} {}{rest}", m.words(), parts.join(" and "))
-        } else if significant && mean_rel.is_finite() {
-            format!(
-                "{} {}-predicted by {:.0} % {}",
-                m.words(),
-                if mean_rel < 0.0 { "under" } else { "over" },
-                mean_rel.abs() * 100.0,
-                place
-            )
-        } else if significant {
-            format!("{} missed {} (the simulation falls)", m.words(), place)
-        } else {
-            format!("{} within noise", m.words())
-        };
+        let regimes = regimes_of(&rs, alpha);
+        let statement = statement_of(m, &regimes, significant, mean_rel, [lmin, lmax]);
         out.push(MetricGap {
             metric: m,
             n: rs.len(),
@@ -223,6 +145,92 @@ pub fn metric_gaps(res: &[Residual], alpha: f64) -> Vec<MetricGap> {
         });
     }
     out
+}
+
+/// One metric's gap per design and size.
+fn regimes_of(rs: &[&Residual], alpha: f64) -> Vec<RegimeGap> {
+    let mut keys: Vec<(String, String)> = rs
+        .iter()
+        .map(|r| (r.design.clone(), sig3(r.leg_length_m)))
+        .collect();
+    keys.sort();
+    keys.dedup();
+    keys.iter()
+        .map(|(dn, lk)| {
+            let g: Vec<&&Residual> = rs
+                .iter()
+                .filter(|r| &r.design == dn && &sig3(r.leg_length_m) == lk)
+                .collect();
+            let c2: f64 = g.iter().map(|r| z2(r)).sum();
+            let rel: Vec<f64> = g.iter().filter_map(|r| r.relative).collect();
+            let p = chi2_sf(c2, g.len() as f64);
+            RegimeGap {
+                design: dn.clone(),
+                leg_length_m: g[0].leg_length_m,
+                n: g.len(),
+                rms_z: (c2 / g.len() as f64).sqrt(),
+                mean_relative_pct: 100.0 * rel.iter().sum::<f64>() / rel.len().max(1) as f64,
+                p_value: p,
+                significant: p < alpha,
+            }
+        })
+        .collect()
+}
+
+/// A metric's gap in words: where it lies when some regimes carry it, else its mean miss.
+fn statement_of(
+    m: Metric,
+    regimes: &[RegimeGap],
+    significant: bool,
+    mean_rel: f64,
+    [lmin, lmax]: [f64; 2],
+) -> String {
+    let place = if (lmax / lmin - 1.0).abs() < 0.05 {
+        format!("at L ≈ {} m", sig3(lmin))
+    } else {
+        format!("over L = {}–{} m", sig3(lmin), sig3(lmax))
+    };
+    let hot: Vec<&RegimeGap> = regimes.iter().filter(|g| g.significant).collect();
+    let same_sign = (hot.iter().all(|g| g.mean_relative_pct < 0.0)
+        || hot.iter().all(|g| g.mean_relative_pct >= 0.0))
+        && regimes.iter().all(|g| g.design == regimes[0].design);
+    let side = |pct: f64| if pct < 0.0 { "under" } else { "over" };
+    if significant
+        && regimes.len() > 1
+        && !hot.is_empty()
+        && !(hot.len() == regimes.len() && same_sign)
+    {
+        let parts: Vec<String> = hot
+            .iter()
+            .map(|g| {
+                format!(
+                    "{}-predicted by {:.0} % at L ≈ {} m ({})",
+                    side(g.mean_relative_pct),
+                    g.mean_relative_pct.abs(),
+                    sig3(g.leg_length_m),
+                    g.design
+                )
+            })
+            .collect();
+        let rest = if hot.len() < regimes.len() {
+            ", within noise elsewhere"
+        } else {
+            ""
+        };
+        format!("{} {}{rest}", m.words(), parts.join(" and "))
+    } else if significant && mean_rel.is_finite() {
+        format!(
+            "{} {}-predicted by {:.0} % {}",
+            m.words(),
+            side(mean_rel),
+            mean_rel.abs() * 100.0,
+            place
+        )
+    } else if significant {
+        format!("{} missed {} (the simulation falls)", m.words(), place)
+    } else {
+        format!("{} within noise", m.words())
+    }
 }
 
 /// Three significant digits, no trailing zeros.

@@ -17,9 +17,14 @@ use crate::sim::{ContactScaling, Design, MassLaw, WalkOptions, simulate_walk};
 /// section of `sim walk`), and the metrics average over the rest.
 pub const CYCLES_PER_TRIAL: f64 = 16.0;
 
+/// Drive cycles a logged condition's walk settles before its cycle is measured.
+pub const SETTLE_CYCLES: usize = 6;
+
 /// A resolved trial condition: the design at 1× and what the trial changes.
 #[derive(Clone, Debug)]
 pub struct Condition {
+    /// The trial names a log: its walks also give the steady cycle's Fourier coefficients.
+    pub cycles: bool,
     pub design: Design,
     pub leg_length_m: f64,
     pub mass_law: MassLaw,
@@ -30,6 +35,40 @@ pub struct Condition {
     /// Servo torque limit or bang-bang torque magnitude.
     pub torque_nm: Option<f64>,
     pub slope_deg: Option<f64>,
+}
+
+/// What one walk of a condition gives: its metrics and, for a logged condition, the
+/// Fourier coefficients of its steady cycle ([`super::waveform::flat`]; None when it fell or
+/// the condition has no log). Channels 0–7 are the metrics ([`Metric::index`]), the
+/// coefficients follow.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Walked {
+    pub metrics: SimMetrics,
+    pub cycles: Option<std::sync::Arc<[f64]>>,
+}
+
+impl Walked {
+    /// The value of a channel (NaN where the walk has none).
+    pub fn channel(&self, ch: usize) -> f64 {
+        if ch < Metric::ALL.len() {
+            self.metrics.values[ch]
+        } else {
+            self.cycles
+                .as_ref()
+                .and_then(|c| c.get(ch - Metric::ALL.len()).copied())
+                .unwrap_or(f64::NAN)
+        }
+    }
+
+    /// The channels a walk of this condition has: the metrics, and the cycle's if logged.
+    pub fn channels_of(condition: &Condition) -> usize {
+        Metric::ALL.len()
+            + if condition.cycles {
+                super::waveform::CHANNELS
+            } else {
+                0
+            }
+    }
 }
 
 /// Simulated metrics of one condition, by [`Metric::index`] (NaN: not computed, or the
@@ -71,12 +110,7 @@ pub fn resolve(set: &TrialSet) -> Result<Vec<Condition>, GapError> {
 }
 
 fn resolve_trial(t: &Trial, origin: &str, base: &Path) -> Result<Condition, GapError> {
-    let at = |message: String| GapError::Trials {
-        path: origin.to_string(),
-        line: t.line,
-        column: 0,
-        message,
-    };
+    let at = |message: String| GapError::at(origin, t.line, 0, message);
     let design = match Design::builtin(&t.design) {
         Ok(d) => d,
         Err(crate::sim::SimError::UnknownDesign(_)) => {
@@ -98,25 +132,21 @@ fn resolve_trial(t: &Trial, origin: &str, base: &Path) -> Result<Condition, GapE
         Err(e) => return Err(at(e.to_string())),
     };
     let is_servo = matches!(design.control, ControlSpec::ServoSine { .. });
-    if t.amplitude_deg.is_some() && !is_servo {
-        return Err(at(format!(
-            "amplitude_deg given, but design {} is driven by bang-bang torque (no amplitude)",
-            t.design
-        )));
+    // A drive column the design's controller does not have.
+    let foreign = match (is_servo, t.amplitude_deg, t.torque_limit_nm, t.torque_nm) {
+        (false, Some(_), _, _) => Some((
+            "amplitude_deg",
+            "is driven by bang-bang torque (no amplitude)",
+        )),
+        (false, _, Some(_), _) => Some(("torque_limit_nm", "is bang-bang: use torque_nm")),
+        (true, _, _, Some(_)) => Some(("torque_nm", "is a position servo: use torque_limit_nm")),
+        _ => None,
+    };
+    if let Some((column, why)) = foreign {
+        return Err(at(format!("{column} given, but design {} {why}", t.design)));
     }
-    if t.torque_limit_nm.is_some() && !is_servo {
-        return Err(at(format!(
-            "torque_limit_nm given, but design {} is bang-bang: use torque_nm",
-            t.design
-        )));
-    }
-    if t.torque_nm.is_some() && is_servo {
-        return Err(at(format!(
-            "torque_nm given, but design {} is a position servo: use torque_limit_nm",
-            t.design
-        )));
-    }
-    Ok(Condition {
+    let c = Condition {
+        cycles: t.trajectory.is_some(),
         design,
         leg_length_m: t.leg_length_m,
         mass_law: t.mass_law.unwrap_or_default(),
@@ -126,10 +156,33 @@ fn resolve_trial(t: &Trial, origin: &str, base: &Path) -> Result<Condition, GapE
         amplitude_deg: t.amplitude_deg,
         torque_nm: t.torque_limit_nm.or(t.torque_nm),
         slope_deg: t.slope_deg,
-    })
+    };
+    c.check_drive().map_err(at)?;
+    Ok(c)
 }
 
 impl Condition {
+    /// The drive must be one the design's time step resolves: 2π·f·dt ≤ 1 at the trial's
+    /// size (the bound every oscillation of the simulator keeps).
+    fn check_drive(&self) -> Result<(), String> {
+        let d = self.scaled_design().map_err(|e| e.to_string())?;
+        let f = match (self.frequency_hz, d.controller().frequency_hz()) {
+            (Some(f), _) | (None, Some(f)) => f,
+            (None, None) => return Ok(()),
+        };
+        let dt = d.numerics.time_step_s;
+        let omega_dt = std::f64::consts::TAU * f * dt;
+        if omega_dt.is_finite() && omega_dt <= 1.0 {
+            Ok(())
+        } else {
+            Err(format!(
+                "frequency_hz = {f}: the design's time step ({dt} s at this size) cannot resolve \
+                 a drive that fast (2π·f·dt = {omega_dt:.3e} > 1; at most {:.4} Hz)",
+                1.0 / (std::f64::consts::TAU * dt)
+            ))
+        }
+    }
+
     /// The design scaled to the condition, with the setting's parameter values (on the 1×
     /// design) and effects added (at the design's 1×, scaled with it by each effect's rule).
     pub fn design_with(
@@ -141,10 +194,7 @@ impl Condition {
         let mut d = self
             .design
             .with_values(&values)
-            .map_err(|e| GapError::Sim {
-                origin: self.design.name.clone(),
-                source: e,
-            })?;
+            .map_err(GapError::sim(&self.design.name))?;
         // Effect magnitudes are in the nominal design's units (its m·g·L, foot modulus, …):
         // the SI value of an effect does not move when a parameter is recalibrated.
         for e in &setting.effects {
@@ -161,37 +211,26 @@ impl Condition {
         }
         let mut d = d
             .scaled(self.leg_length_m, self.mass_law, self.contact)
-            .map_err(|e| GapError::Sim {
-                origin: self.design.name.clone(),
-                source: e,
-            })?;
+            .map_err(GapError::sim(&self.design.name))?;
         if let Some(m) = self.mass_kg {
             d.carrying(m);
         }
-        match &mut d.control {
+        let (frequency_hz, torque_nm) = match &mut d.control {
             ControlSpec::ServoSine {
                 frequency_hz,
                 torque_limit_nm,
                 ..
-            } => {
-                if let Some(f) = self.frequency_hz {
-                    *frequency_hz = f;
-                }
-                if let Some(t) = self.torque_nm {
-                    *torque_limit_nm = t;
-                }
-            }
+            } => (frequency_hz, torque_limit_nm),
             ControlSpec::BangBang {
                 frequency_hz,
                 torque_nm,
-            } => {
-                if let Some(f) = self.frequency_hz {
-                    *frequency_hz = f;
-                }
-                if let Some(t) = self.torque_nm {
-                    *torque_nm = t;
-                }
-            }
+            } => (frequency_hz, torque_nm),
+        };
+        if let Some(f) = self.frequency_hz {
+            *frequency_hz = f;
+        }
+        if let Some(t) = self.torque_nm {
+            *torque_nm = t;
         }
         Ok(d)
     }
@@ -201,10 +240,7 @@ impl Condition {
     pub fn scaled_design(&self) -> Result<Design, GapError> {
         self.design
             .scaled(self.leg_length_m, self.mass_law, self.contact)
-            .map_err(|e| GapError::Sim {
-                origin: self.design.name.clone(),
-                source: e,
-            })
+            .map_err(GapError::sim(&self.design.name))
     }
 
     /// Whether the condition's walking direction is set by the walker's start, not by the
@@ -225,13 +261,14 @@ impl Condition {
         Ok(d.controller().frequency_hz().unwrap_or(f64::NAN))
     }
 
-    /// Simulates the condition under `setting` and measures the metrics.
+    /// Simulates the condition under `setting` and measures the metrics (and the cycle, for
+    /// a logged condition).
     pub fn simulate(
         &self,
         lib: &EffectLibrary,
         setting: &ModelSetting,
-    ) -> Result<SimMetrics, GapError> {
-        self.walk(lib, setting, false).map(|(m, _)| m)
+    ) -> Result<Walked, GapError> {
+        self.simulate_from(lib, setting, None)
     }
 
     /// Simulates the condition under `setting`: the metrics and the trajectory (kept when
@@ -252,8 +289,21 @@ impl Condition {
         lib: &EffectLibrary,
         setting: &ModelSetting,
         seed: Option<u64>,
-    ) -> Result<SimMetrics, GapError> {
-        self.walk_from(lib, setting, false, seed).map(|(m, _)| m)
+    ) -> Result<Walked, GapError> {
+        let (metrics, trajectory) = self.walk_from(lib, setting, self.cycles, seed)?;
+        let cycles = if self.cycles && !metrics.fell {
+            let f = self
+                .design_with(lib, setting)?
+                .controller()
+                .frequency_hz()
+                .unwrap_or(1.0);
+            super::waveform::signature(&super::waveform::log_of(&trajectory), f, SETTLE_CYCLES)
+                .ok()
+                .map(|sig| super::waveform::flat(&sig).into())
+        } else {
+            None
+        };
+        Ok(Walked { metrics, cycles })
     }
 
     fn walk_from(
@@ -290,40 +340,13 @@ impl Condition {
     }
 }
 
-/// The spread of one condition's metrics over several walks of it: each metric's sample sd
-/// (n − 1); where some walks fell and others did not, the largest |value| (the metric's own
-/// size: a fall is as far off as the metric can be); 0 where every walk fell.
-pub fn metric_spread<'a>(walks: impl IntoIterator<Item = &'a SimMetrics>) -> [f64; 8] {
-    let walks: Vec<&SimMetrics> = walks.into_iter().collect();
-    let mut out = [0.0; 8];
-    for (m, row) in out.iter_mut().enumerate() {
-        let finite: Vec<f64> = walks
-            .iter()
-            .map(|w| w.values[m])
-            .filter(|x| x.is_finite())
-            .collect();
-        *row = if finite.is_empty() {
-            0.0
-        } else if finite.len() < walks.len() {
-            finite.iter().map(|x| x.abs()).fold(0.0, f64::max)
-        } else if finite.len() > 1 {
-            let mean = finite.iter().sum::<f64>() / finite.len() as f64;
-            (finite.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / (finite.len() - 1) as f64)
-                .sqrt()
-        } else {
-            0.0
-        };
-    }
-    out
-}
-
 /// Simulates many (condition, setting) jobs in parallel, in order.
 pub fn simulate_jobs(
     jobs: &[(usize, ModelSetting)],
     conditions: &[Condition],
     lib: &EffectLibrary,
     progress: &dyn Observer,
-) -> Result<Vec<SimMetrics>, GapError> {
+) -> Result<Vec<Walked>, GapError> {
     jobs.par_iter()
         .map(|(i, s)| {
             let r = conditions[*i].simulate(lib, s);

@@ -1,35 +1,42 @@
-//! The next trials to run: the conditions, at the user's own robot size, where the two
-//! leading explanations of the trials (fitted to them by [`super::separate`]) differ most —
-//! the expected likelihood-ratio statistic between them, in the trials' own noise units,
-//! on the summaries and on the logged cycles — computed with the simulator.
+//! The next trials to run: the conditions, at the robot's own size, whose measurement is
+//! expected to reduce the posterior's entropy most — the expected information gain of a
+//! trial about which explanation holds (Lindley 1956), computed with the simulator.
 //!
-//! The pool is a grid over what a lab can change on one robot without rebuilding it: drive
-//! frequency, servo amplitude (position-servo designs), payload and ground slope, within
-//! [`POOL`]'s ranges; a condition is offered only where the nominal model and both leading
-//! explanations walk forward (a trial that falls measures nothing, and risks the robot; one
-//! that scuffs in place is on a gait where another engine, or the robot, parts from the
-//! model most: Drake-Lagged at such conditions, `tests/golden/drake/gap-lagged-next/`).
+//! The leading explanations of the trials (the diagnosis' posterior, until their
+//! probabilities add up to 0.99, six at most) are each walked at their most probable point on
+//! every condition of a pool of what a lab can change on one robot without rebuilding it:
+//! drive frequency, servo amplitude (position-servo designs), payload and ground slope
+//! ([`POOL`]). A new trial's summaries are predicted as Gaussian about each explanation's
+//! walk, with the trials' own relative sd; the expected entropy of the posterior after the
+//! trials is estimated by Monte Carlo over their predicted outcomes (fixed seeds), and the
+//! budget is filled greedily, each next condition the one that lowers the expected entropy
+//! of the chosen set most. A condition where an explanation falls is never offered (it
+//! measures nothing and risks the robot), nor, unless asked, one where a model does not walk
+//! forward (where another engine, or the robot, parts from the model most).
+//!
+//! The prediction uses each explanation's most probable point, not its whole posterior: a
+//! condition where an explanation's gait changes within its own credible interval is scored
+//! as if it did not.
 
+use rand::SeedableRng;
+use rand_chacha::ChaCha8Rng;
 use rayon::prelude::*;
 use serde::Serialize;
 
+use super::cache::SimCache;
+use super::diagnose::{DiagnoseOptions, Diagnosis, diagnose_conditions, suspects};
 use super::error::GapError;
+use super::knob::{Knobs, ModelSetting};
 use super::library::EffectLibrary;
-use super::separate::{
-    CycleCache, Evidence, SeparateOptions, SimCycle, measured_signatures, separate_with,
-    simulate_cycles,
-};
-use super::simulate::{Condition, resolve};
+use super::likelihood::normal;
+use super::simulate::{Condition, SimMetrics, resolve};
 use super::synth::round_sig;
 use super::trials::{Metric, Trial, TrialSet};
-use super::waveform;
 use crate::progress::Observer;
 use crate::sim::design::ControlSpec;
 
 /// The pool's levels: drive frequency (× the design's at the robot's size), servo amplitude
-/// (× the design's), payload (fraction of the robot's mass added) and slope [deg, downhill
-/// positive]. ±15 % in frequency and ±20 % in amplitude stay near the gait the design was
-/// tuned for; 30 % payload and 2° are what a bench test adds without new hardware.
+/// (× the design's), payload (fraction of the robot's mass added) and slope [deg].
 pub struct Pool {
     pub frequency_factors: &'static [f64],
     pub amplitude_factors: &'static [f64],
@@ -44,31 +51,18 @@ pub const POOL: Pool = Pool {
     slopes_deg: &[-2.0, 0.0, 2.0],
 };
 
-/// Step of a leader's value for the smoothness check, as a fraction of its range in its
-/// coordinate (effects: ln magnitude, so ≈ ±10 % for a range of two decades).
-const SMOOTHNESS_STEP: f64 = 0.02;
-/// Largest bend (m₋ + m₊ − 2m₀, in the new trial's sds) a metric may show over the step:
-/// beyond it the gait changes character within the candidate's own uncertainty.
-const SMOOTHNESS_Z: f64 = 2.0;
-
-/// Largest expected z² one metric (or one signal's cycle) of one trial may contribute: a
-/// 5-sd difference already decides; beyond it the two models walk qualitatively different
-/// gaits there (a bifurcation), where the simulator's own resolution is least trusted, so a
-/// larger number must not rank a knife-edge condition first.
-const MAX_Z2: f64 = 25.0;
+/// Predicted outcomes drawn per evaluation of the expected entropy.
+const DRAWS: usize = 256;
 
 #[derive(Clone, Debug)]
 pub struct SuggestOptions {
     pub budget: usize,
-    pub separate: SeparateOptions,
     /// Relative sd assumed for the new trials' summaries (the median of the trials' own when
     /// they state sds).
     pub default_relative_sd: f64,
-    /// Also offer conditions where a model stands, scuffs or walks backward (not falls). In
-    /// the simulator's own world they separate look-alikes best (hip Coulomb friction vs
-    /// damping: 10/10 named with them, 5/10 without); on another engine they made an answer
-    /// worse (`tests/golden/drake/gap-lagged-next/README.md`).
+    /// Also offer conditions where a model stands, scuffs or walks backward (not falls).
     pub any_gait: bool,
+    pub diagnose: DiagnoseOptions,
 }
 
 /// A condition to run next.
@@ -80,42 +74,35 @@ pub struct Suggested {
     pub amplitude_deg: Option<f64>,
     pub mass_kg: f64,
     pub slope_deg: f64,
-    /// Expected LR statistic between the two leading explanations on this trial's summaries
-    /// (noiseless, in the trials' sd units).
-    pub separation_summaries: f64,
-    /// The same on its cycles (with the model-error floor).
-    pub separation_waveforms: f64,
+    /// Expected entropy of the posterior (nats) after the trials chosen up to this one.
+    pub expected_entropy: f64,
 }
 
 #[derive(Clone, Debug, Serialize)]
 pub struct Suggestion {
     /// The design as the trials name it (bundled name or TOML path).
     pub design: String,
-    /// The two leading explanations and their fitted values (SI).
+    /// The leading explanations and their probabilities.
     pub leading: Vec<(String, f64)>,
+    /// The posterior's entropy now (nats, over the leading explanations renormalised).
+    pub entropy_now: f64,
     pub budget: usize,
-    /// Pool conditions tried, and those offered: all three models walk forward and the
-    /// leaders' gaits are smooth there.
+    /// Pool conditions tried, offered, and left out (a fall; not walking forward).
     pub pool: usize,
-    pub walkable: usize,
-    /// Conditions left out because a model, without falling, does not walk forward there
-    /// (steady speed at or below the design's walking threshold: it stands, scuffs or walks
-    /// backward).
+    pub offered: usize,
+    pub fell: usize,
     pub not_forward: usize,
-    /// Whether conditions off the forward gait were offered too ([`SuggestOptions::any_gait`]).
     pub any_gait: bool,
-    /// Conditions left out because a leader's metrics bend sharply there (or a step falls).
-    pub knife_edge: usize,
     pub relative_sd: f64,
     /// Best first.
     pub suggested: Vec<Suggested>,
-    /// The design's default condition at the robot's size (its own drive), for comparison.
-    pub default_condition: Option<Suggested>,
+    /// The expected entropy after one trial at the design's own condition, for comparison.
+    pub default_entropy: Option<f64>,
     pub walks: usize,
 }
 
-/// Suggests `opts.budget` conditions that best separate the two leading candidates among
-/// `opts.separate.candidates` on the trials of `set`.
+/// Suggests `opts.budget` conditions that most reduce the expected entropy of the trials'
+/// posterior.
 pub fn suggest(
     set: &TrialSet,
     lib: &EffectLibrary,
@@ -129,251 +116,206 @@ pub fn suggest(
         )));
     }
     let conditions = resolve(set)?;
-    let sigs = measured_signatures(set, &conditions, opts.separate.settle_cycles)?;
-    let cache = CycleCache::default();
-    let sep = separate_with(
-        set,
-        &conditions,
-        &sigs,
-        lib,
-        &opts.separate,
-        &cache,
-        progress,
-    )?;
-    let ranking = sep
-        .rankings
+    let cache = SimCache::default();
+    let (d, _) = diagnose_conditions(set, &conditions, lib, &opts.diagnose, &cache, progress)?;
+    let leading = leaders(&d);
+    // The knobs the diagnosis weighed.
+    let knobs = suspects(&conditions, lib, &opts.diagnose, "the trials' designs")?;
+    let settings: Vec<ModelSetting> = leading
         .iter()
-        .find(|r| r.evidence == Evidence::SummariesAndWaveforms)
-        .or_else(|| sep.rankings.first())
-        .ok_or_else(|| GapError::Invalid("no ranking of the candidates".into()))?;
-    let leading: Vec<(String, f64)> = ranking
-        .fits
-        .iter()
-        .take(2)
-        .map(|f| (f.knob.clone(), f.value))
-        .collect();
-    let settings = separate_settings(&conditions, lib, &leading)?;
-    // The robot's own size and design: the most common of the trials (first on ties).
+        .map(|(label, _)| setting_of(&d, label, &knobs, lib))
+        .collect::<Result<_, _>>()?;
     let robot = robot_condition(&conditions)?;
-    let base = conditions[robot].clone();
-    let design = set.trials[robot].design.clone();
-    let relative_sd = trials_relative_sd(set).unwrap_or(opts.default_relative_sd);
-    let (pool, default_index) = pool_conditions(&base)?;
-    let models = [
-        super::knob::ModelSetting::nominal(),
-        settings[0].clone(),
-        settings[1].clone(),
-    ];
-    let settle = opts.separate.settle_cycles;
-    let walks: Vec<[SimCycle; 3]> = pool
+    let (pool, default_index) = pool_conditions(&conditions[robot])?;
+    progress.stage(&format!(
+        "walking {} explanations on {} pool conditions",
+        settings.len(),
+        pool.len()
+    ));
+    let walks: Vec<Vec<SimMetrics>> = pool
         .par_iter()
         .map(|c| {
-            let r = [
-                simulate_cycles(c, lib, &models[0], settle)?,
-                simulate_cycles(c, lib, &models[1], settle)?,
-                simulate_cycles(c, lib, &models[2], settle)?,
-            ];
+            let w = settings
+                .iter()
+                .map(|s| c.simulate(lib, s).map(|w| w.metrics))
+                .collect::<Result<Vec<_>, _>>();
             progress.tick();
-            Ok(r)
+            w
         })
-        .collect::<Result<_, GapError>>()?;
-    let fell: Vec<bool> = walks
-        .iter()
-        .map(|w| w.iter().any(|x| x.metrics.fell))
-        .collect();
+        .collect::<Result<_, _>>()?;
+    let relative_sd = trials_relative_sd(set).unwrap_or(opts.default_relative_sd);
+    let weights: Vec<f64> = renormalised(&leading);
+    let fell: Vec<bool> = walks.iter().map(|w| w.iter().any(|m| m.fell)).collect();
     let forward: Vec<bool> = pool
         .iter()
         .zip(&walks)
-        .zip(&fell)
-        .map(|((c, w), &fell)| !fell && (opts.any_gait || walks_forward(c, w)))
+        .map(|(c, w)| opts.any_gait || walks_forward(c, w))
         .collect();
-    let smooth: Vec<bool> = pool
-        .par_iter()
-        .zip(&walks)
-        .zip(&forward)
-        .map(|((c, w), &f)| {
-            let ok = f && is_smooth(c, w, lib, &settings, settle, relative_sd)?;
-            if ok {
-                progress.tick();
-            }
-            Ok(ok)
-        })
-        .collect::<Result<_, GapError>>()?;
-    let not_forward = fell
-        .iter()
-        .zip(&forward)
-        .filter(|(fell, f)| !**fell && !**f)
-        .count();
-    let knife_edge = forward
-        .iter()
-        .zip(&smooth)
-        .filter(|(f, ok)| **f && !**ok)
-        .count();
-    let forward_count = forward.iter().filter(|f| **f).count();
-    let floor = opts.separate.relative_floor;
-    let score = |c: &Condition, w: &[SimCycle; 3]| score_condition(c, w, relative_sd, floor);
-    let mut scored: Vec<Suggested> = pool
-        .iter()
-        .zip(&walks)
-        .zip(&smooth)
-        .filter(|(_, ok)| **ok)
-        .filter_map(|((c, w), _)| score(c, w))
+    let offered: Vec<usize> = (0..pool.len())
+        .filter(|&i| !fell[i] && forward[i])
         .collect();
-    let walkable = scored.len();
-    let with_logs = sep.trials_with_logs > 0;
-    let total = |s: &Suggested| {
-        s.separation_summaries
-            + if with_logs {
-                s.separation_waveforms
-            } else {
-                0.0
-            }
-    };
-    let default_condition = default_index.and_then(|i| score(&pool[i], &walks[i]));
-    // Best first; ties (and equal floats) broken by the pool's order, so the answer is
-    // deterministic.
-    scored.sort_by(|a, b| total(b).total_cmp(&total(a)));
-    scored.truncate(opts.budget);
-    for (k, s) in scored.iter_mut().enumerate() {
-        s.label = format!("next-{}", k + 1);
+    let score = |chosen: &[usize]| expected_entropy(&weights, &walks, chosen, relative_sd);
+    let mut chosen: Vec<usize> = Vec::new();
+    let mut suggested = Vec::new();
+    while chosen.len() < opts.budget {
+        let best = offered
+            .par_iter()
+            .filter(|i| !chosen.contains(i))
+            .map(|&i| {
+                let mut with = chosen.clone();
+                with.push(i);
+                (i, score(&with))
+            })
+            .min_by(|a, b| a.1.total_cmp(&b.1).then(a.0.cmp(&b.0)));
+        let Some((i, h)) = best else { break };
+        chosen.push(i);
+        suggested.push(described(&pool[i], h, suggested.len() + 1)?);
     }
     Ok(Suggestion {
-        design,
+        design: set.trials[robot].design.clone(),
+        entropy_now: entropy(&weights),
         leading,
         budget: opts.budget,
         pool: pool.len(),
-        walkable,
-        not_forward,
+        offered: offered.len(),
+        fell: fell.iter().filter(|f| **f).count(),
+        not_forward: (0..pool.len()).filter(|&i| !fell[i] && !forward[i]).count(),
         any_gait: opts.any_gait,
-        knife_edge,
         relative_sd,
-        suggested: scored,
-        default_condition,
-        walks: sep.walks + 3 * pool.len() + 4 * forward_count,
+        suggested,
+        default_entropy: default_index.filter(|i| !fell[*i]).map(|i| score(&[i])),
+        walks: d.walks_evaluated + pool.len() * settings.len(),
     })
 }
 
-/// Whether the nominal and both leaders walk forward at `c`: no fall and a steady speed
-/// above the design's walking threshold, the criterion of `WalkReport::walks` (the
-/// criteria are dimensionless: the unscaled design's serve at every size).
-fn walks_forward(c: &Condition, w: &[SimCycle; 3]) -> bool {
-    let threshold_mps = c.design.criteria.walk_speed_threshold_mps(c.leg_length_m);
-    w.iter()
-        .all(|x| !x.metrics.fell && x.metrics.get(Metric::VelocityMps) > threshold_mps)
+/// The leading explanations (not "something outside these", which predicts nothing) until
+/// their probabilities add up to 0.99, six at most.
+fn leaders(d: &Diagnosis) -> Vec<(String, f64)> {
+    let mut out = Vec::new();
+    let mut acc = 0.0;
+    for l in d
+        .posterior
+        .iter()
+        .filter(|l| l.explanation != super::hypothesis::NONE_OF_THESE)
+    {
+        out.push((l.explanation.clone(), l.probability));
+        acc += l.probability;
+        if acc >= 0.99 || out.len() == 6 {
+            break;
+        }
+    }
+    out
 }
 
-/// Smoothness: each leader a step below and above its fitted value; a condition where
-/// the metrics bend more than SMOOTHNESS_Z sds over that step (or a step falls) is a
-/// knife-edge gait: a trial there cannot be fitted reliably, whatever it separates.
-/// `w` are the condition's walks under the nominal and the two leaders, `settings` those
-/// of [`separate_settings`].
-fn is_smooth(
-    c: &Condition,
-    w: &[SimCycle; 3],
+fn renormalised(leading: &[(String, f64)]) -> Vec<f64> {
+    let total: f64 = leading.iter().map(|l| l.1).sum();
+    leading
+        .iter()
+        .map(|l| l.1 / total.max(f64::MIN_POSITIVE))
+        .collect()
+}
+
+/// The entropy (nats) of the weights `w`.
+pub fn entropy(w: &[f64]) -> f64 {
+    w.iter().filter(|p| **p > 0.0).map(|p| -p * p.ln()).sum()
+}
+
+/// The simulator's setting of an explanation at its most probable values (from the
+/// diagnosis' table of explanations).
+fn setting_of(
+    d: &Diagnosis,
+    label: &str,
+    knobs: &Knobs,
     lib: &EffectLibrary,
-    settings: &[super::knob::ModelSetting],
-    settle: usize,
-    relative_sd: f64,
-) -> Result<bool, GapError> {
-    if w.iter().any(|x| x.metrics.fell) {
-        return Ok(false);
+) -> Result<ModelSetting, GapError> {
+    let mut point = knobs.nominal_point();
+    if label == "nominal" {
+        return Ok(ModelSetting::nominal());
     }
-    for (lead, (lo, hi)) in [(1usize, (2usize, 3usize)), (2, (4, 5))] {
-        let minus = simulate_cycles(c, lib, &settings[lo], settle)?;
-        let plus = simulate_cycles(c, lib, &settings[hi], settle)?;
-        if minus.metrics.fell || plus.metrics.fell {
-            return Ok(false);
-        }
-        for m in Metric::SIMULATED {
-            let (a, b, x) = (
-                minus.metrics.get(m),
-                plus.metrics.get(m),
-                w[lead].metrics.get(m),
-            );
-            if a.is_finite() && b.is_finite() && x.is_finite() && x != 0.0 {
-                let bend = (a + b - 2.0 * x).abs() / (relative_sd * x.abs());
-                if bend > SMOOTHNESS_Z {
-                    return Ok(false);
+    let e = d
+        .explanations
+        .iter()
+        .find(|e| e.explanation == label)
+        .ok_or_else(|| GapError::Invalid(format!("explanation {label} has no values")))?;
+    for n in &e.knobs {
+        let k = knobs
+            .index_of(&n.knob)
+            .ok_or_else(|| GapError::Invalid(format!("unknown knob {}", n.knob)))?;
+        let knob = &knobs.list[k];
+        point[k] = Some(knob.coordinate(n.value / knob.si_per_value));
+    }
+    Ok(knobs.setting(lib, &point))
+}
+
+/// The expected entropy (nats) of the explanations' posterior after trials at the
+/// `chosen` pool conditions, by Monte Carlo: an explanation drawn by its weight, its
+/// predicted summaries with Gaussian noise of sd `relative_sd`·|value|, the posterior of
+/// every explanation on that outcome.
+pub fn expected_entropy(
+    weights: &[f64],
+    walks: &[Vec<SimMetrics>],
+    chosen: &[usize],
+    relative_sd: f64,
+) -> f64 {
+    let mut rng = ChaCha8Rng::seed_from_u64(0x5eed);
+    let mut total = 0.0;
+    for draw in 0..DRAWS {
+        // The truth for this draw: explanations in proportion to their weights (stratified).
+        let u = (draw as f64 + 0.5) / DRAWS as f64;
+        let mut acc = 0.0;
+        let truth = weights
+            .iter()
+            .position(|w| {
+                acc += w;
+                u < acc
+            })
+            .unwrap_or(weights.len() - 1);
+        let mut logs: Vec<f64> = weights
+            .iter()
+            .map(|w| w.max(f64::MIN_POSITIVE).ln())
+            .collect();
+        for &c in chosen {
+            for m in Metric::SIMULATED {
+                let mu = walks[c][truth].get(m);
+                if !mu.is_finite() || mu == 0.0 {
+                    continue;
+                }
+                let sd = relative_sd * mu.abs();
+                let y = mu + sd * normal(&mut rng);
+                for (h, l) in logs.iter_mut().enumerate() {
+                    let p = walks[c][h].get(m);
+                    let z = if p.is_finite() { (y - p) / sd } else { 100.0 };
+                    *l -= 0.5 * z * z;
                 }
             }
         }
+        let max = logs.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+        let z: f64 = logs.iter().map(|l| (l - max).exp()).sum();
+        let post: Vec<f64> = logs.iter().map(|l| (l - max).exp() / z).collect();
+        total += entropy(&post);
     }
-    Ok(true)
+    total / DRAWS as f64
 }
 
-/// How far apart the two leaders' walks at a condition are (summaries and waveforms,
-/// each term capped at MAX_Z2); `None` when a walk fell or the design cannot be scaled.
-fn score_condition(
-    c: &Condition,
-    w: &[SimCycle; 3],
-    relative_sd: f64,
-    floor: f64,
-) -> Option<Suggested> {
-    if w.iter().any(|x| x.metrics.fell) {
-        return None;
-    }
-    let (a, b) = (&w[1], &w[2]);
-    let mut s = 0.0;
-    for m in Metric::SIMULATED {
-        let (x, y) = (a.metrics.get(m), b.metrics.get(m));
-        if x.is_finite() && y.is_finite() && x != 0.0 {
-            s += ((x - y) / (relative_sd * x.abs())).powi(2).min(MAX_Z2);
-        }
-    }
-    let wv = match (&a.cycles, &b.cycles) {
-        (Some(x), Some(y)) => waveform::chi2(x, y, floor)
-            .per_signal
-            .iter()
-            .map(|(_, c2, _)| c2.min(MAX_Z2))
-            .sum(),
-        _ => 0.0,
-    };
-    let scaled = c.scaled_design().ok()?;
-    Some(Suggested {
-        label: String::new(),
+/// Whether every explanation walks forward at `c`: a steady speed above the design's
+/// walking threshold (a fall is counted apart).
+fn walks_forward(c: &Condition, w: &[SimMetrics]) -> bool {
+    let threshold_mps = c.design.criteria.walk_speed_threshold_mps(c.leg_length_m);
+    w.iter()
+        .all(|x| x.fell || x.get(Metric::VelocityMps) > threshold_mps)
+}
+
+fn described(c: &Condition, h: f64, k: usize) -> Result<Suggested, GapError> {
+    let scaled = c.scaled_design()?;
+    Ok(Suggested {
+        label: format!("next-{k}"),
         leg_length_m: c.leg_length_m,
         frequency_hz: c.frequency_hz.unwrap_or(f64::NAN),
         amplitude_deg: c.amplitude_deg,
         mass_kg: c.mass_kg.unwrap_or(scaled.mass.total_mass_kg),
         slope_deg: c.slope_deg.unwrap_or(0.0),
-        separation_summaries: s,
-        separation_waveforms: wv,
+        expected_entropy: h,
     })
-}
-
-/// The settings of the two leading candidates at their fitted values, and each a step
-/// [`SMOOTHNESS_STEP`] (of its range, in its coordinate) below and above: [A, B, A−, A+, B−, B+].
-fn separate_settings(
-    conditions: &[Condition],
-    lib: &EffectLibrary,
-    leading: &[(String, f64)],
-) -> Result<Vec<super::knob::ModelSetting>, GapError> {
-    let designs = super::diagnose::designs_of(conditions);
-    let effects: Vec<_> = lib.effects.iter().collect();
-    let knobs = super::knob::Knobs::build(&designs, &effects, true).map_err(|e| GapError::Sim {
-        origin: "designs".into(),
-        source: e,
-    })?;
-    let mut at = Vec::new();
-    let mut steps = Vec::new();
-    for (label, si) in leading {
-        let k = knobs
-            .index_of(label)
-            .ok_or_else(|| GapError::Invalid(format!("unknown knob {label}")))?;
-        let knob = &knobs.list[k];
-        let x = knob.coordinate(si / knob.si_per_value);
-        let h = SMOOTHNESS_STEP * (knob.hi - knob.lo);
-        let setting = |x: f64| {
-            let mut point = knobs.nominal_point();
-            point[k] = Some(x);
-            knobs.setting(lib, &point)
-        };
-        at.push(setting(x));
-        steps.push(setting(x - h));
-        steps.push(setting(x + h));
-    }
-    at.extend(steps);
-    Ok(at)
 }
 
 /// The index of the robot's own condition: the most common (design, size) of the trials.
@@ -414,17 +356,13 @@ fn pool_conditions(base: &Condition) -> Result<(Vec<Condition>, Option<usize>), 
     let scaled = base.scaled_design()?;
     let f0 = scaled.controller().frequency_hz().unwrap_or(1.0);
     let m0 = scaled.mass.total_mass_kg;
-    let servo_amplitude = match &base.design.control {
-        ControlSpec::ServoSine { amplitude_deg, .. } => Some(*amplitude_deg),
-        _ => None,
-    };
-    let amplitudes: Vec<(Option<f64>, bool)> = match servo_amplitude {
-        Some(a) => POOL
+    let amplitudes: Vec<(Option<f64>, bool)> = match &base.design.control {
+        ControlSpec::ServoSine { amplitude_deg, .. } => POOL
             .amplitude_factors
             .iter()
-            .map(|k| (Some(a * k), *k == 1.0))
+            .map(|k| (Some(amplitude_deg * k), *k == 1.0))
             .collect(),
-        None => vec![(None, true)],
+        _ => vec![(None, true)],
     };
     let mut out = Vec::new();
     let mut default = None;
@@ -436,6 +374,7 @@ fn pool_conditions(base: &Condition) -> Result<(Vec<Condition>, Option<usize>), 
                         default = Some(out.len());
                     }
                     let mut c = base.clone();
+                    c.cycles = false;
                     c.frequency_hz = Some(f0 * kf);
                     c.amplitude_deg = a;
                     c.mass_kg = Some(m0 * (1.0 + p));
@@ -461,9 +400,8 @@ pub fn as_trials(s: &Suggestion) -> Vec<Trial> {
             t.mass_kg = Some(round_sig(x.mass_kg, 6));
             t.slope_deg = Some(x.slope_deg);
             t.source = format!(
-                "suggested by survey gap suggest: separates {} from {}",
-                s.leading.first().map(|l| l.0.as_str()).unwrap_or("?"),
-                s.leading.get(1).map(|l| l.0.as_str()).unwrap_or("?")
+                "suggested by survey gap suggest: expected entropy of the posterior {:.3} nats after it",
+                x.expected_entropy
             );
             t
         })

@@ -1,12 +1,14 @@
 //! Synthetic "real" trials: the simulator with effects the nominal model lacks, plus
 //! Gaussian measurement noise, over a default set of conditions or given ones.
 
-use rand::{Rng, SeedableRng};
+use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 
+use super::cases::resolve_design;
 use super::error::GapError;
 use super::knob::ModelSetting;
 use super::library::{EffectLibrary, EffectSetting};
+use super::likelihood::normal;
 use super::simulate::{Condition, SimMetrics, resolve};
 use super::trials::{Measurement, Metric, Trial, TrialSet};
 use crate::progress::Observer;
@@ -24,10 +26,7 @@ pub const MIN_CONDITIONS: usize = 12;
 /// The default conditions for `design_name`: sizes × drive frequencies at which the nominal
 /// design walks (m ∝ L², similar contact).
 pub fn default_conditions(design_name: &str) -> Result<Vec<Trial>, GapError> {
-    let design = Design::resolve(design_name).map_err(|e| GapError::Sim {
-        origin: design_name.to_string(),
-        source: e,
-    })?;
+    let design = resolve_design(design_name)?;
     let f0 = design.controller().frequency_hz().unwrap_or(1.0);
     let walks: Vec<bool> = {
         use rayon::prelude::*;
@@ -43,10 +42,7 @@ pub fn default_conditions(design_name: &str) -> Result<Vec<Trial>, GapError> {
                 simulate_walk(&design, &o).map(|r| r.report.walks)
             })
             .collect::<Result<Vec<bool>, _>>()
-            .map_err(|e| GapError::Sim {
-                origin: design_name.to_string(),
-                source: e,
-            })?
+            .map_err(GapError::sim(design_name))?
     };
     let mut freqs: Vec<f64> = FREQUENCY_FACTORS
         .iter()
@@ -85,14 +81,6 @@ pub(crate) fn round_sig(x: f64, digits: i32) -> f64 {
     }
     let p = 10f64.powi(digits - 1 - x.abs().log10().floor() as i32);
     (x * p).round() / p
-}
-
-/// A standard normal draw by Box–Muller from ChaCha8 (rand_distr is not a dependency and
-/// one transform does not justify one).
-fn normal(rng: &mut ChaCha8Rng) -> f64 {
-    let u1: f64 = 1.0 - rng.random::<f64>();
-    let u2: f64 = rng.random::<f64>();
-    (-2.0 * u1.ln()).sqrt() * (std::f64::consts::TAU * u2).cos()
 }
 
 /// Measured trials from true metrics: value + FRACTION·|value|·N(0, 1), sd = FRACTION·|value|.
@@ -249,15 +237,17 @@ impl SynthOptions {
         }
         let mut params = Vec::new();
         for arg in set {
+            let bad = |why: String| GapError::Invalid(format!("--set {arg}: {why}"));
             let (path, value) = arg
                 .split_once('=')
-                .ok_or_else(|| GapError::Invalid(format!("--set {arg}: expected PATH=VALUE")))?;
-            let value: f64 = value.trim().parse().map_err(|_| {
-                GapError::Invalid(format!("--set {arg}: {value:?} is not a number"))
-            })?;
+                .ok_or_else(|| bad("expected PATH=VALUE".into()))?;
+            let value: f64 = value
+                .trim()
+                .parse()
+                .map_err(|_| bad(format!("{value:?} is not a number")))?;
             design
                 .with_value(path.trim(), value)
-                .map_err(|e| GapError::Invalid(format!("--set {arg}: {e}")))?;
+                .map_err(|e| bad(e.to_string()))?;
             params.push((path.trim().to_string(), value));
             command.push_str(&format!(" --set {arg}"));
         }
@@ -284,20 +274,43 @@ pub fn synthesize(
     command: &str,
     progress: &dyn Observer,
 ) -> Result<TrialSet, GapError> {
-    check_noise(opts.noise)?;
-    let set = conditions_or_default(opts, conditions)?;
-    let resolved = resolve(&set)?;
-    let setting = setting_of(opts, &resolved);
+    let (set, resolved, setting) = opts.robot(conditions)?;
     let truth = truth_metrics(&resolved, lib, &setting, progress)?;
     let trials = opts.trials(&set.trials, &truth, command);
-    Ok(TrialSet {
-        origin: set.origin,
-        base_dir: set.base_dir,
-        trials,
-    })
+    Ok(TrialSet { trials, ..set })
 }
 
 impl SynthOptions {
+    /// The synthetic robot's conditions (None: the design's defaults), resolved, and its
+    /// setting: the parameter values (on every design of the trials) and effects.
+    fn robot(
+        &self,
+        conditions: Option<TrialSet>,
+    ) -> Result<(TrialSet, Vec<Condition>, ModelSetting), GapError> {
+        check_noise(self.noise)?;
+        let set = match conditions {
+            Some(s) => s,
+            None => TrialSet {
+                origin: format!("default conditions of {}", self.design),
+                base_dir: std::path::PathBuf::from("."),
+                trials: default_conditions(&self.design)?,
+            },
+        };
+        let resolved = resolve(&set)?;
+        let designs: std::collections::BTreeSet<&str> =
+            resolved.iter().map(|c| c.design.name.as_str()).collect();
+        let params = designs.iter().flat_map(|d| {
+            self.params
+                .iter()
+                .map(move |(p, v)| (d.to_string(), p.clone(), *v))
+        });
+        let setting = ModelSetting {
+            params: params.collect(),
+            effects: self.effects.clone(),
+        };
+        Ok((set, resolved, setting))
+    }
+
     /// The measured trials from the true metrics: noise drawn from the seed, or the expected
     /// values.
     fn trials(&self, conditions: &[Trial], truth: &[SimMetrics], source: &str) -> Vec<Trial> {
@@ -318,38 +331,6 @@ fn check_noise(noise: f64) -> Result<(), GapError> {
     Ok(())
 }
 
-fn conditions_or_default(
-    opts: &SynthOptions,
-    conditions: Option<TrialSet>,
-) -> Result<TrialSet, GapError> {
-    Ok(match conditions {
-        Some(s) => s,
-        None => TrialSet {
-            origin: format!("default conditions of {}", opts.design),
-            base_dir: std::path::PathBuf::from("."),
-            trials: default_conditions(&opts.design)?,
-        },
-    })
-}
-
-/// The parameter values (on every design of the trials) and effects of the synthetic robot.
-fn setting_of(opts: &SynthOptions, resolved: &[Condition]) -> ModelSetting {
-    ModelSetting {
-        params: resolved
-            .iter()
-            .map(|c| c.design.name.clone())
-            .collect::<std::collections::BTreeSet<_>>()
-            .into_iter()
-            .flat_map(|d| {
-                opts.params
-                    .iter()
-                    .map(move |(p, v)| (d.clone(), p.clone(), *v))
-            })
-            .collect(),
-        effects: opts.effects.clone(),
-    }
-}
-
 /// The true metrics of the conditions under `setting` (parameter values and effects).
 pub fn truth_metrics(
     conditions: &[Condition],
@@ -361,7 +342,7 @@ pub fn truth_metrics(
     conditions
         .par_iter()
         .map(|c| {
-            let r = c.simulate(lib, setting);
+            let r = c.simulate(lib, setting).map(|w| w.metrics);
             progress.tick();
             r
         })
@@ -380,10 +361,7 @@ pub fn synthesize_logs(
     progress: &dyn Observer,
 ) -> Result<(TrialSet, Vec<Vec<super::waveform::LogSample>>), GapError> {
     use rayon::prelude::*;
-    check_noise(opts.noise)?;
-    let set = conditions_or_default(opts, conditions)?;
-    let resolved = resolve(&set)?;
-    let setting = setting_of(opts, &resolved);
+    let (set, resolved, setting) = opts.robot(conditions)?;
     let walked: Vec<(SimMetrics, Vec<crate::sim::TrajectorySample>)> = resolved
         .par_iter()
         .map(|c| {
@@ -401,12 +379,5 @@ pub fn synthesize_logs(
             add_sensor_noise(&super::waveform::log_of(tr), sensor, log_seed(opts.seed, i))
         })
         .collect();
-    Ok((
-        TrialSet {
-            origin: set.origin,
-            base_dir: set.base_dir,
-            trials,
-        },
-        logs,
-    ))
+    Ok((TrialSet { trials, ..set }, logs))
 }

@@ -5,7 +5,7 @@ use std::path::{Path, PathBuf};
 
 use serde::Serialize;
 
-use super::error::GapError;
+use super::error::{GapError, read_text};
 use crate::sim::{ContactScaling, MassLaw, WalkReport};
 
 /// A measured gait metric (the simulator's [`WalkReport`] names).
@@ -210,10 +210,7 @@ pub fn columns() -> Vec<String> {
 
 impl TrialSet {
     pub fn read(path: &Path) -> Result<TrialSet, GapError> {
-        let text = std::fs::read_to_string(path).map_err(|source| GapError::Read {
-            path: path.to_path_buf(),
-            source,
-        })?;
+        let text = read_text(path)?;
         let base = path.parent().map(Path::to_path_buf).unwrap_or_default();
         TrialSet::parse(&text, &path.display().to_string(), &base)
     }
@@ -230,7 +227,7 @@ impl TrialSet {
         for rec in rdr.records() {
             let rec = rec.map_err(|e| {
                 let line = e.position().map(|p| p.line()).unwrap_or(0);
-                trials_error(origin, line, 1, format!("malformed row: {e}"))
+                GapError::at(origin, line, 1, format!("malformed row: {e}"))
             })?;
             let row = TrialRow {
                 origin,
@@ -241,7 +238,7 @@ impl TrialSet {
             trials.push(row.trial()?);
         }
         if trials.is_empty() {
-            return Err(trials_error(
+            return Err(GapError::at(
                 origin,
                 1,
                 1,
@@ -308,15 +305,6 @@ fn trial_row(t: &Trial) -> Vec<String> {
     row
 }
 
-fn trials_error(origin: &str, line: u64, column: usize, message: String) -> GapError {
-    GapError::Trials {
-        path: origin.to_string(),
-        line,
-        column,
-        message,
-    }
-}
-
 /// The header: every column known, none twice, the required ones there. Returns each
 /// column's index.
 fn read_columns(
@@ -324,7 +312,7 @@ fn read_columns(
     origin: &str,
 ) -> Result<std::collections::HashMap<String, usize>, GapError> {
     let err =
-        |line: u64, column: usize, message: String| trials_error(origin, line, column, message);
+        |line: u64, column: usize, message: String| GapError::at(origin, line, column, message);
     let headers = rdr
         .headers()
         .map_err(|e| err(1, 1, format!("cannot read the header: {e}")))?
@@ -368,7 +356,7 @@ struct TrialRow<'a> {
 
 impl TrialRow<'_> {
     fn err(&self, column: usize, message: String) -> GapError {
-        trials_error(self.origin, self.line, column, message)
+        GapError::at(self.origin, self.line, column, message)
     }
 
     /// A non-empty cell with its 1-based column.
@@ -400,33 +388,29 @@ impl TrialRow<'_> {
         }
     }
 
-    /// A required cell (its column is there, `read_columns` checked) that is empty.
-    fn empty(&self, name: &str, message: &str) -> GapError {
-        self.err(self.col[name] + 1, message.into())
+    /// A cell's text (None: empty).
+    fn text(&self, name: &str) -> Option<String> {
+        self.cell(name).map(|(_, v)| v.to_string())
+    }
+
+    /// The error of a required cell (its column is there, `read_columns` checked) that is
+    /// empty; `why` says why it is needed.
+    fn empty(&self, name: &str, why: &str) -> GapError {
+        self.err(self.col[name] + 1, format!("{name}: empty; {why}"))
     }
 
     fn trial(&self) -> Result<Trial, GapError> {
-        let design = match self.cell("design") {
-            Some((_, v)) => v.to_string(),
-            None => {
-                return Err(self.empty(
-                    "design",
-                    "design: empty; name a bundled design or a design TOML path",
-                ));
-            }
-        };
+        let design = self
+            .text("design")
+            .ok_or_else(|| self.empty("design", "name a bundled design or a design TOML path"))?;
+        let leg = |x: f64| (1e-3..=100.0).contains(&x);
         let leg_length_m = self
             .number(
                 "leg_length_m",
-                &|x| (1e-3..=100.0).contains(&x),
+                &leg,
                 "must be a leg length in [0.001, 100] m",
             )?
-            .ok_or_else(|| {
-                self.empty(
-                    "leg_length_m",
-                    "leg_length_m: empty; every trial needs its leg length",
-                )
-            })?;
+            .ok_or_else(|| self.empty("leg_length_m", "every trial needs its leg length"))?;
         let (mass_law, contact) = self.laws()?;
         let positive = |x: f64| x > 0.0;
         let mass_kg = self.number("mass_kg", &positive, "must be > 0 kg")?;
@@ -440,21 +424,12 @@ impl TrialRow<'_> {
         let torque_nm = self.number("torque_nm", &positive, "must be > 0 N·m")?;
         let slope_deg = self.number("slope_deg", &|x| x.abs() <= 45.0, "must be within ±45 deg")?;
         let measured = self.measurements()?;
-        let source = self
-            .cell("source")
-            .map(|(_, v)| v.to_string())
-            .ok_or_else(|| {
-                self.empty(
-                    "source",
-                    "source: empty; every trial must say where its numbers come from",
-                )
-            })?;
+        let source = self.text("source").ok_or_else(|| {
+            self.empty("source", "every trial must say where its numbers come from")
+        })?;
         Ok(Trial {
             line: self.line,
-            label: self
-                .cell("label")
-                .map(|(_, v)| v.to_string())
-                .unwrap_or_default(),
+            label: self.text("label").unwrap_or_default(),
             design,
             leg_length_m,
             mass_kg,
@@ -466,7 +441,7 @@ impl TrialRow<'_> {
             torque_nm,
             slope_deg,
             measured,
-            trajectory: self.cell("trajectory").map(|(_, v)| v.to_string()),
+            trajectory: self.text("trajectory"),
             source,
         })
     }

@@ -16,21 +16,22 @@ use std::path::Path;
 use nalgebra::{DMatrix, DVector};
 use serde::Serialize;
 
-use super::error::GapError;
+use super::error::{GapError, read_text};
 use crate::sim::TrajectorySample;
 
 /// Harmonics kept per signal (the cycle's mean plus cos/sin of 1..=H times the drive
 /// frequency). The gaits' signals are mostly smooth at the drive period (pitch's main
-/// component is the second harmonic, the hip torque's shape the third and fourth: see
-/// reports/gap-example-cycles.svg), but look-alikes act in short windows: backlash
-/// delivers no torque while the lash closes after each reversal, latency shifts every
-/// edge. Measured on the waveform benchmark's latency ↔ backlash cells at 1× threshold
-/// (16 seeds each, 3 % noise, floor 5 %): 4 harmonics named 12 + 12 of 32, 8 named 13 + 15,
-/// 12 named 15 + 16 (reports/gap-benchmark.md, 2026-11-27, third session). A log needs
-/// 2H + 8 samples per cycle (Nyquist for the 12th harmonic, with room for the least squares).
+/// component is the second harmonic, the hip torque's shape the third and fourth), but
+/// look-alikes act in short windows: backlash delivers no torque while the lash closes after
+/// each reversal, latency shifts every edge; more harmonics tell them apart better. A log
+/// needs 2H + 8 samples per cycle (Nyquist for the 12th harmonic, with room for the least
+/// squares).
 pub const HARMONICS: usize = 12;
 /// Coefficients per signal and cycle: the mean, then a cosine and a sine per harmonic.
-const COEFFICIENTS: usize = 1 + 2 * HARMONICS;
+pub const COEFFICIENTS: usize = 1 + 2 * HARMONICS;
+/// Channels of a cycle in a walk's outputs: every signal's coefficients, in
+/// [`Signal::ALL`] order ([`flat`]).
+pub const CHANNELS: usize = Signal::ALL.len() * COEFFICIENTS;
 /// Bins of the phase-averaged cycle drawn in the figure.
 pub const FIGURE_BINS: usize = 48;
 /// Fewest samples per cycle for a cycle to count (the fit has 2H + 2 unknowns).
@@ -39,7 +40,7 @@ pub const MIN_SAMPLES_PER_CYCLE: usize = 2 * HARMONICS + 8;
 pub const MIN_CYCLES: usize = 3;
 
 /// A logged signal.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash, Serialize)]
 #[serde(rename_all = "snake_case")]
 pub enum Signal {
     HipAngle,
@@ -76,16 +77,22 @@ impl Signal {
         }
     }
 
+    /// The cycle channel of this signal's coefficient `c`.
+    pub fn channel(self, c: usize) -> usize {
+        let k = Signal::ALL.iter().position(|s| *s == self).unwrap_or(0);
+        k * COEFFICIENTS + c
+    }
+
     /// Yaw's mean is the heading (arbitrary) and it drifts when the walker turns: its cycle
     /// is fitted with a trend and without its mean.
     fn has_trend(self) -> bool {
         self == Signal::Yaw
     }
 
-    /// Sensor resolution floor of a coefficient, in the signal's unit (an IMU or encoder
-    /// does not resolve a cycle's harmonic below ≈ 0.05°); torque has no absolute floor
-    /// (its scale depends on the robot's size) and relies on the relative one.
-    fn absolute_floor(self) -> f64 {
+    /// Sensor resolution of a coefficient, in the signal's unit (an IMU or encoder does not
+    /// resolve a cycle's harmonic below ≈ 0.05°); torque has none (its scale depends on the
+    /// robot's size): its cycle-to-cycle spread stands for it.
+    pub fn absolute_floor(self) -> f64 {
         match self {
             Signal::HipTorque => 0.0,
             _ => 0.05,
@@ -146,15 +153,12 @@ pub const OPTIONAL_COLUMNS: [&str; 2] = ["hip_torque_nm", "drive_phase_cycles"];
 /// only the columns a robot records. Errors when the file cannot be read.
 pub fn is_full_trajectory(path: &Path) -> Result<bool, GapError> {
     use std::io::BufRead;
-    let read = |source| GapError::Read {
-        path: path.to_path_buf(),
-        source,
-    };
+    let read = GapError::read(path);
     // The header only: the log itself is read once, by the caller that needs its samples.
-    let file = std::fs::File::open(path).map_err(read)?;
+    let file = std::fs::File::open(path).map_err(&read)?;
     let mut header = String::new();
     for line in std::io::BufReader::new(file).lines() {
-        let line = line.map_err(read)?;
+        let line = line.map_err(&read)?;
         if !line.trim_start().starts_with('#') {
             header = line;
             break;
@@ -176,20 +180,14 @@ pub fn is_full_trajectory(path: &Path) -> Result<bool, GapError> {
 /// such as the simulator's full trajectory format are ignored), then one sample per line.
 /// Errors name the file, line and column.
 pub fn read_log_csv(path: &Path) -> Result<Vec<LogSample>, GapError> {
-    let text = std::fs::read_to_string(path).map_err(|source| GapError::Read {
-        path: path.to_path_buf(),
-        source,
-    })?;
+    let text = read_text(path)?;
     parse_log(&text, &path.display().to_string())
 }
 
 /// [`read_log_csv`] on text (`origin` names it in errors).
 pub fn parse_log(text: &str, origin: &str) -> Result<Vec<LogSample>, GapError> {
-    let bad = |line: usize, column: usize, message: String| GapError::Trials {
-        path: origin.to_string(),
-        line: line as u64,
-        column,
-        message,
+    let bad = |line: usize, column: usize, message: String| {
+        GapError::at(origin, line as u64, column, message)
     };
     let mut lines = text
         .lines()
@@ -223,22 +221,15 @@ pub fn parse_log(text: &str, origin: &str) -> Result<Vec<LogSample>, GapError> {
         }
         let cells: Vec<&str> = line.split(',').map(str::trim).collect();
         let number = |col: usize, name: &str| -> Result<f64, GapError> {
+            let bad_cell = |what: String| bad(i + 1, col + 1, format!("column `{name}`: {what}"));
             let cell = cells
                 .get(col)
-                .ok_or_else(|| bad(i + 1, col + 1, format!("column `{name}`: missing cell")))?;
-            let v = cell.parse::<f64>().map_err(|_| {
-                bad(
-                    i + 1,
-                    col + 1,
-                    format!("column `{name}`: `{cell}` is not a number"),
-                )
-            })?;
+                .ok_or_else(|| bad_cell("missing cell".into()))?;
+            let v = cell
+                .parse::<f64>()
+                .map_err(|_| bad_cell(format!("`{cell}` is not a number")))?;
             if !v.is_finite() {
-                return Err(bad(
-                    i + 1,
-                    col + 1,
-                    format!("column `{name}`: {v} is not finite"),
-                ));
+                return Err(bad_cell(format!("{v} is not finite")));
             }
             Ok(v)
         };
@@ -351,6 +342,18 @@ impl CycleSignature {
     }
 }
 
+/// A signature's mean coefficients as channels: [`COEFFICIENTS`] per signal in
+/// [`Signal::ALL`] order, NaN for a signal the log lacks.
+pub fn flat(sig: &CycleSignature) -> Vec<f64> {
+    let mut out = vec![f64::NAN; CHANNELS];
+    for c in &sig.signals {
+        for (i, v) in c.coefficients.iter().enumerate().take(COEFFICIENTS) {
+            out[c.signal.channel(i)] = *v;
+        }
+    }
+    out
+}
+
 /// The steady cycle of every signal the log has: cycles `settle_cycles` and later (whole
 /// cycles only), each fitted by least squares with the mean and [`HARMONICS`] harmonics
 /// (plus a trend for yaw); their mean and spread. Errors when fewer than [`MIN_CYCLES`]
@@ -439,12 +442,10 @@ pub fn signature(
 
 /// The least-squares basis of one cycle's sample phases: [1, cos 2πφ, sin 2πφ, …,
 /// cos 2πHφ, sin 2πHφ, φ − ½] per sample (the last, a trend, for yaw only), with the
-/// normal equations factored once for every signal of the cycle. Hand-written rather than
-/// an SVD per signal: with 12 harmonics the SVD made the cycle fits cost more than the
-/// walks of a `gap separate` run (2× its CPU); the Fourier columns are near-orthogonal over
-/// a whole cycle, so the normal equations lose nothing, and a cycle whose Gram matrix is
-/// not positive definite falls back to the SVD.
-struct CycleBasis {
+/// normal equations factored once for every signal of the cycle: far cheaper than an SVD per
+/// signal, and as exact, since the Fourier columns are near-orthogonal over a whole cycle. A
+/// cycle whose Gram matrix is not positive definite falls back to the SVD.
+pub struct CycleBasis {
     /// Samples × (1 + 2H + 1).
     a: DMatrix<f64>,
     plain: Option<nalgebra::linalg::Cholesky<f64, nalgebra::Dyn>>,
@@ -452,7 +453,8 @@ struct CycleBasis {
 }
 
 impl CycleBasis {
-    fn new(phases: impl Iterator<Item = f64>) -> CycleBasis {
+    /// The basis of the sample phases `phases` (in cycles).
+    pub fn new(phases: impl Iterator<Item = f64>) -> CycleBasis {
         let phases: Vec<f64> = phases.collect();
         let k = COEFFICIENTS;
         let mut a = DMatrix::zeros(phases.len(), k + 1);
@@ -476,7 +478,7 @@ impl CycleBasis {
 
     /// [a₀, a₁, b₁, …, a_H, b_H] of the samples `y` (with the trend column fitted and
     /// dropped when `trend`).
-    fn fit(&self, y: &[f64], trend: bool) -> Option<Vec<f64>> {
+    pub fn fit(&self, y: &[f64], trend: bool) -> Option<Vec<f64>> {
         let k = COEFFICIENTS;
         let cols = k + usize::from(trend);
         let a = self.a.columns(0, cols);
@@ -502,280 +504,4 @@ pub fn evaluate(coef: &[f64], phi: f64) -> f64 {
         y += coef[2 * h - 1] * x.cos() + coef[2 * h] * x.sin();
     }
     y
-}
-
-/// The χ² of a simulated cycle against a measured one, per signal.
-#[derive(Clone, Debug, Default, PartialEq, Serialize)]
-pub struct WaveformChi2 {
-    pub chi2: f64,
-    /// Coefficients compared.
-    pub n: usize,
-    /// (signal, χ², coefficients) for each signal both sides have.
-    pub per_signal: Vec<(Signal, f64, usize)>,
-}
-
-/// z = (simulated − measured)/σ per coefficient, with σ² the sum of the measured mean's sd²
-/// (spread²/n), the simulated mean's sd² and the floor², where floor = max(relative_floor ·
-/// the measured signal's RMS, the sensor floor). The floor is the model error a cycle is allowed: without
-/// it a few hundred cycles of a real log would resolve differences no simulator can be
-/// trusted to (the same floor stands between the summaries' sd and their exactness).
-pub fn chi2(
-    measured: &CycleSignature,
-    simulated: &CycleSignature,
-    relative_floor: f64,
-) -> WaveformChi2 {
-    let mut out = WaveformChi2::default();
-    for m in &measured.signals {
-        let Some(s) = simulated.signal(m.signal) else {
-            continue;
-        };
-        let floor = (relative_floor * m.rms).max(m.signal.absolute_floor());
-        let (nm, ns) = (measured.cycles as f64, simulated.cycles as f64);
-        let mut c2 = 0.0;
-        let mut n = 0;
-        for c in 0..m.coefficients.len() {
-            let (x, y) = (s.coefficients[c], m.coefficients[c]);
-            if !(x.is_finite() && y.is_finite()) {
-                continue;
-            }
-            let var = m.spread[c].powi(2) / nm + s.spread[c].powi(2) / ns + floor * floor;
-            if var > 0.0 {
-                c2 += (x - y).powi(2) / var;
-                n += 1;
-            }
-        }
-        out.chi2 += c2;
-        out.n += n;
-        out.per_signal.push((m.signal, c2, n));
-    }
-    out
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    fn log_of_fn(f: impl Fn(f64) -> f64, hz: f64, cycles: f64, per_cycle: usize) -> Vec<LogSample> {
-        let n = (cycles * per_cycle as f64) as usize;
-        (0..n)
-            .map(|i| {
-                let t = i as f64 / (per_cycle as f64 * hz);
-                LogSample {
-                    t_s: t,
-                    hip_angle_deg: f(t),
-                    roll_deg: 0.5 * f(t),
-                    pitch_deg: 1.0,
-                    yaw_deg: 3.0 * t + (std::f64::consts::TAU * hz * t).sin(),
-                    hip_torque_nm: None,
-                    drive_phase_cycles: None,
-                }
-            })
-            .collect()
-    }
-
-    /// `log` with white Gaussian noise of sd `sd_deg` on every angle: Box–Muller on ChaCha8,
-    /// drawn hip, roll, pitch, yaw for each sample, the sequence `synth::add_sensor_noise`
-    /// makes for a log without torque. Made here so that these tests name no file above this
-    /// one (synth uses waveform, not the other way).
-    fn with_white_noise(log: &[LogSample], sd_deg: f64, seed: u64) -> Vec<LogSample> {
-        use rand::{Rng, SeedableRng};
-        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed);
-        let mut n = || {
-            let u1: f64 = 1.0 - rng.random::<f64>();
-            let u2: f64 = rng.random::<f64>();
-            (-2.0 * u1.ln()).sqrt() * (std::f64::consts::TAU * u2).cos()
-        };
-        log.iter()
-            .map(|s| LogSample {
-                hip_angle_deg: s.hip_angle_deg + sd_deg * n(),
-                roll_deg: s.roll_deg + sd_deg * n(),
-                pitch_deg: s.pitch_deg + sd_deg * n(),
-                yaw_deg: s.yaw_deg + sd_deg * n(),
-                ..*s
-            })
-            .collect()
-    }
-
-    /// A known waveform: y = 2 + 10 sin 2πft + 3 cos 4πft − 1 sin 6πft + ½ cos 20πft gives
-    /// a₀ = 2, b₁ = 10, a₂ = 3, b₃ = −1, a₁₀ = ½ and nothing else, exactly (the tenth
-    /// harmonic: the short features of backlash and latency live that high); yaw's linear
-    /// drift is removed and its sin term kept; a constant has RMS 0.
-    #[test]
-    fn harmonics_of_a_known_waveform() {
-        let hz = 1.7;
-        let tau = std::f64::consts::TAU;
-        let f = |t: f64| {
-            2.0 + 10.0 * (tau * hz * t).sin() + 3.0 * (2.0 * tau * hz * t).cos()
-                - (3.0 * tau * hz * t).sin()
-                + 0.5 * (10.0 * tau * hz * t).cos()
-        };
-        let log = log_of_fn(f, hz, 12.3, 150);
-        let sig = signature(&log, hz, 2).expect("signature");
-        assert_eq!(sig.cycles, 10, "cycles 2..=11; the cut 12th is dropped");
-        let hip = sig.signal(Signal::HipAngle).expect("hip");
-        // [a₀, a₁, b₁, a₂, b₂, …]: a_h at 2h − 1, b_h at 2h.
-        let mut want = vec![0.0; COEFFICIENTS];
-        (want[0], want[2], want[3], want[6], want[19]) = (2.0, 10.0, 3.0, -1.0, 0.5);
-        assert_eq!(hip.coefficients.len(), want.len());
-        for (c, w) in hip.coefficients.iter().zip(&want) {
-            assert!((c - w).abs() < 1e-9, "{:?} vs {want:?}", hip.coefficients);
-        }
-        // RMS of the AC part: √((10² + 3² + 1² + ½²)/2).
-        assert!((hip.rms - (110.25f64 / 2.0).sqrt()).abs() < 1e-9);
-        let yaw = sig.signal(Signal::Yaw).expect("yaw");
-        assert!(yaw.coefficients[0].is_nan());
-        assert!(
-            (yaw.coefficients[2] - 1.0).abs() < 1e-9,
-            "{:?}",
-            yaw.coefficients
-        );
-        let pitch = sig.signal(Signal::Pitch).expect("pitch");
-        assert!((pitch.coefficients[0] - 1.0).abs() < 1e-12 && pitch.rms < 1e-9);
-        assert!(sig.signal(Signal::HipTorque).is_none(), "no torque column");
-        // The rebuilt cycle at phase ¼: 2 + 10 − 3 + 1 + ½·cos 5π = 9.5.
-        assert!((evaluate(&hip.coefficients, 0.25) - 9.5).abs() < 1e-9);
-    }
-
-    /// The drive phase column wins over f·t: a log whose clock starts 0.25 cycle late but
-    /// carries the phase gives the same coefficients as the aligned one.
-    #[test]
-    fn drive_phase_column_aligns_a_late_clock() {
-        let hz = 2.0;
-        let tau = std::f64::consts::TAU;
-        let f = |t: f64| 5.0 * (tau * hz * t).sin();
-        let aligned = log_of_fn(f, hz, 10.0, 100);
-        let late: Vec<LogSample> = aligned
-            .iter()
-            .map(|s| LogSample {
-                drive_phase_cycles: Some(s.t_s * hz),
-                t_s: s.t_s + 0.125,
-                ..*s
-            })
-            .collect();
-        let a = signature(&aligned, hz, 1).expect("a");
-        let b = signature(&late, hz, 1).expect("b");
-        let (ha, hb) = (
-            a.signal(Signal::HipAngle).unwrap(),
-            b.signal(Signal::HipAngle).unwrap(),
-        );
-        for (x, y) in ha.coefficients.iter().zip(&hb.coefficients) {
-            assert!((x - y).abs() < 1e-9);
-        }
-    }
-
-    /// White noise of sd σ on N samples per cycle gives a harmonic coefficient a spread of
-    /// σ·√(2/N) (least squares on an orthogonal basis); checked over 60 cycles to 25 %.
-    #[test]
-    fn spread_of_white_noise_matches_least_squares_theory() {
-        let hz = 1.0;
-        let clean = log_of_fn(|t| (std::f64::consts::TAU * t).sin(), hz, 63.0, 200);
-        let noisy = with_white_noise(&clean, 0.4, 7);
-        let sig = signature(&noisy, hz, 2).expect("sig");
-        let hip = sig.signal(Signal::HipAngle).unwrap();
-        let want = 0.4 * (2.0f64 / 200.0).sqrt();
-        for c in 1..hip.spread.len() {
-            assert!(
-                (hip.spread[c] / want - 1.0).abs() < 0.25,
-                "coefficient {c}: spread {} vs {want}",
-                hip.spread[c]
-            );
-        }
-        // A signature against itself is χ² 0; against a copy shifted by 2 floors in one
-        // coefficient, 4.
-        let same = chi2(&sig, &sig, 0.05);
-        assert_eq!(same.chi2, 0.0);
-        let mut shifted = sig.clone();
-        // The floor: 5 % of the RMS (0.035° here) or the sensor floor 0.05°, the larger.
-        let floor = (0.05 * hip.rms).max(0.05);
-        let var = 2.0 * hip.spread[2].powi(2) / sig.cycles as f64 + floor * floor;
-        shifted.signals[0].coefficients[2] += 2.0 * var.sqrt();
-        let c = chi2(&sig, &shifted, 0.05);
-        assert!((c.chi2 - 4.0).abs() < 1e-9, "{}", c.chi2);
-    }
-
-    /// The factored normal equations against an independent solver: on an irregularly
-    /// sampled stretch of a cycle (phases 0.05–0.95, jittered; 40 samples) of an arbitrary
-    /// signal, with and without the trend column, the coefficients equal nalgebra's SVD
-    /// least squares of the same design matrix (built here with direct cos/sin).
-    #[test]
-    fn cycle_fit_equals_svd_least_squares_on_irregular_samples() {
-        let phases: Vec<f64> = (0..40)
-            .map(|i| 0.05 + 0.9 * (i as f64 + 0.37 * ((i * 7 % 5) as f64 / 5.0)) / 40.0)
-            .collect();
-        let y: Vec<f64> = phases
-            .iter()
-            .map(|p| (3.0 * p).exp() + (17.0 * p).sin() + if *p > 0.6 { 1.5 } else { 0.0 })
-            .collect();
-        let basis = CycleBasis::new(phases.iter().copied());
-        let k = COEFFICIENTS;
-        for trend in [false, true] {
-            let cols = k + usize::from(trend);
-            let a = DMatrix::from_fn(phases.len(), cols, |r, c| {
-                let phi = phases[r];
-                if c == 0 {
-                    1.0
-                } else if c < k {
-                    let x = std::f64::consts::TAU * c.div_ceil(2) as f64 * phi;
-                    if c % 2 == 1 { x.cos() } else { x.sin() }
-                } else {
-                    phi - 0.5
-                }
-            });
-            let want = a
-                .svd(true, true)
-                .solve(&DVector::from_column_slice(&y), 1e-12)
-                .expect("svd");
-            let got = basis.fit(&y, trend).expect("fit");
-            assert_eq!(got.len(), k);
-            for (g, w) in got.iter().zip(want.iter()) {
-                assert!(
-                    (g - w).abs() < 1e-7 * (1.0 + w.abs()),
-                    "{got:?} vs {want:?}"
-                );
-            }
-        }
-    }
-
-    /// A log too coarse for the harmonics kept is refused with the number it needs: 30
-    /// samples per cycle against 2·12 + 8 = 32.
-    #[test]
-    fn a_log_sampled_below_the_harmonics_needs_is_refused() {
-        assert_eq!(MIN_SAMPLES_PER_CYCLE, 32);
-        let log = log_of_fn(|t| t.sin(), 1.0, 10.0, 30);
-        let e = signature(&log, 1.0, 2).expect_err("30 per cycle");
-        assert!(e.contains("at least 32 samples"), "{e}");
-        assert!(signature(&log_of_fn(|t| t.sin(), 1.0, 10.0, 32), 1.0, 2).is_ok());
-    }
-
-    #[test]
-    fn too_few_cycles_and_bad_logs_are_clear_errors() {
-        let log = log_of_fn(|t| t.sin(), 1.0, 4.0, 50);
-        let e = signature(&log, 1.0, 2).expect_err("2 cycles");
-        assert!(e.contains("at least 3"), "{e}");
-        let e = parse_log("t_s,roll_deg,pitch_deg,yaw_deg\n0,0,0,0\n", "x.csv").expect_err("hip");
-        assert!(
-            e.to_string().contains("missing column `hip_angle_deg`"),
-            "{e}"
-        );
-        let e = parse_log(
-            "t_s,hip_angle_deg,roll_deg,pitch_deg,yaw_deg\n0,1,2,3,4\n0.01,1,two,3,4\n",
-            "x.csv",
-        )
-        .expect_err("number");
-        assert!(e.to_string().starts_with("x.csv:3:3:"), "{e}");
-        let e = parse_log(
-            "t_s,hip_angle_deg,roll_deg,pitch_deg,yaw_deg\n0.1,1,2,3,4\n0.1,1,2,3,4\n",
-            "x.csv",
-        )
-        .expect_err("time");
-        assert!(e.to_string().contains("does not increase"), "{e}");
-        let ok = parse_log(
-            "# a comment\nyaw_deg,t_s,pitch_deg,roll_deg,hip_angle_deg,extra\n4,0,3,2,1,x\n",
-            "x.csv",
-        )
-        .expect("any order, extra columns");
-        assert_eq!(ok[0].hip_angle_deg, 1.0);
-        assert_eq!(ok[0].yaw_deg, 4.0);
-        assert!(ok[0].hip_torque_nm.is_none());
-    }
 }

@@ -39,6 +39,10 @@ pub fn crosscheck_md(c: &Crosscheck) -> String {
             pct(r.convex_relative_difference())
         ));
     }
+    out.push_str(&format!(
+        "\nMuJoCo {}: the design's MJCF export (`survey sim export`) walked by tools/mujoco/, measured by the same code.\n",
+        c.mujoco_version.as_deref().unwrap_or("(no goldens found)")
+    ));
     out.push_str("\n| walk | engine | walks | v [m/s] | step f [Hz] | roll p-p [°] | pitch p-p [°] | yaw p-p [°] |\n|---|---|---|---|---|---|---|---|\n");
     for w in &c.walks {
         let drake = match &w.drake_approximation {
@@ -50,28 +54,47 @@ pub fn crosscheck_md(c: &Crosscheck) -> String {
             engines.push(("project (convex)", r));
         }
         engines.push((drake.as_str(), &w.drake));
+        if let Some(m) = &w.mujoco {
+            engines.push(("MuJoCo", m));
+        }
         for (engine, r) in engines {
-            out.push_str(&format!(
-                "| {} | {} | {} | {} | {} | {} ± {} | {} ± {} | {} ± {} |\n",
-                w.name,
-                engine,
-                match (&r.fall_reason, r.walks) {
-                    (Some(f), _) => format!("fell ({f})"),
-                    (None, true) => "yes".into(),
-                    (None, false) => "no".into(),
-                },
-                cell(Some(r.velocity_mps)),
-                cell(Some(r.step_frequency_hz)),
-                cell(Some(r.roll_pp_deg)),
-                cell(Some(r.roll_pp_deg_sd)),
-                cell(Some(r.pitch_pp_deg)),
-                cell(Some(r.pitch_pp_deg_sd)),
-                cell(Some(r.yaw_pp_deg)),
-                cell(Some(r.yaw_pp_deg_sd)),
-            ));
+            out.push_str(&walk_row(&w.name, engine, r));
+        }
+    }
+    if !c.mujoco_walks.is_empty() {
+        out.push_str("\nDesigns Drake's harness does not build (section-cut feet): the project beside MuJoCo.\n\n| walk | engine | walks | v [m/s] | step f [Hz] | roll p-p [°] | pitch p-p [°] | yaw p-p [°] |\n|---|---|---|---|---|---|---|---|\n");
+        for w in &c.mujoco_walks {
+            for (engine, r) in [
+                ("project", &w.project),
+                ("project (convex)", &w.project_convex),
+                ("MuJoCo", &w.mujoco),
+            ] {
+                out.push_str(&walk_row(&w.name, engine, r));
+            }
         }
     }
     out
+}
+
+fn walk_row(name: &str, engine: &str, r: &crate::sim::WalkReport) -> String {
+    format!(
+        "| {} | {} | {} | {} | {} | {} ± {} | {} ± {} | {} ± {} |\n",
+        name,
+        engine,
+        match (&r.fall_reason, r.walks) {
+            (Some(f), _) => format!("fell ({f})"),
+            (None, true) => "yes".into(),
+            (None, false) => "no".into(),
+        },
+        cell(Some(r.velocity_mps)),
+        cell(Some(r.step_frequency_hz)),
+        cell(Some(r.roll_pp_deg)),
+        cell(Some(r.roll_pp_deg_sd)),
+        cell(Some(r.pitch_pp_deg)),
+        cell(Some(r.pitch_pp_deg_sd)),
+        cell(Some(r.yaw_pp_deg)),
+        cell(Some(r.yaw_pp_deg_sd)),
+    )
 }
 
 /// `survey sim min-torque` as text.

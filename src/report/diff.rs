@@ -54,7 +54,7 @@ fn record_line(r: &RecordSummary, with_sources: bool) -> String {
         r.class,
         if r.fit { "fitted" } else { "not fitted" }
     );
-    let survey: Vec<String> = Var::ALL
+    let survey: Vec<String> = Var::SIZES
         .iter()
         .filter_map(|v| {
             let fv = r.value(v.field())?;
@@ -78,7 +78,7 @@ fn record_line(r: &RecordSummary, with_sources: bool) -> String {
     let others = r
         .values
         .iter()
-        .filter(|v| v.field != "sources" && !Var::ALL.iter().any(|x| x.field() == v.field))
+        .filter(|v| v.field != "sources" && !Var::SIZES.iter().any(|x| x.field() == v.field))
         .count();
     if others > 0 {
         out.push_str(&format!("; {others} other value(s)"));
@@ -96,7 +96,7 @@ fn record_line(r: &RecordSummary, with_sources: bool) -> String {
         for fv in r
             .values
             .iter()
-            .filter(|v| Var::ALL.iter().any(|x| x.field() == v.field))
+            .filter(|v| Var::SIZES.iter().any(|x| x.field() == v.field))
         {
             for s in &fv.sources {
                 if !seen.iter().any(|t| t.key == s.key) {
@@ -124,6 +124,10 @@ fn change_row(c: &FieldChange) -> String {
         c.at.as_deref()
             .map(|a| format!(", at: {}", cell(a)))
             .unwrap_or_default();
+    let at = match &c.gait {
+        Some(g) => format!("{at}, gait: {}", cell(g)),
+        None => at,
+    };
     let note = c
         .note
         .as_deref()

@@ -7,8 +7,8 @@ use plotters::prelude::*;
 
 use super::plot::{PlotError, register_font};
 use super::sig;
-use crate::gap::benchmark::{BenchmarkSummary, CaseRow};
-use crate::gap::diagnose::{AnswerKind, Diagnosis};
+use crate::gap::decide::{AnswerKind, Named};
+use crate::gap::diagnose::Diagnosis;
 use crate::gap::explore::{Exploration, PLAUSIBLE_P};
 use crate::gap::knob::KnobKind;
 use crate::gap::library::EffectSummary;
@@ -51,19 +51,19 @@ fn opt(v: Option<f64>) -> String {
 pub fn diagnosis_md(d: &Diagnosis) -> String {
     let mut o = String::new();
     let _ = writeln!(o, "# Gap diagnosis: {}\n", d.trials);
+    let cycles = if d.n_cycle_observations > 0 {
+        format!(
+            " ({} of them Fourier coefficients of logged cycles)",
+            d.n_cycle_observations
+        )
+    } else {
+        String::new()
+    };
     let _ = writeln!(
         o,
-        "{} trials, {} observations. Nominal gap: RMS z = {:.2} (χ² = {:.1}, p = {:.2e}{}).\n",
-        d.n_trials,
-        d.n_observations,
-        d.gap_before,
-        d.chi2_before,
-        d.p_value_before,
-        if d.within_noise {
-            ", within noise"
-        } else {
-            ", beyond noise"
-        }
+        "{} trials, {} observations{cycles}. The nominal model misses them by RMS z = {:.2} \
+         (χ² = {:.1}).\n",
+        d.n_trials, d.n_observations, d.gap_before, d.chi2_before,
     );
     let _ = writeln!(o, "**Where:** {}.\n", d.summary);
     let _ = writeln!(
@@ -72,12 +72,10 @@ pub fn diagnosis_md(d: &Diagnosis) -> String {
         answer_kind(d.answer.kind),
         d.answer.statement
     );
-    where_md(&mut o, d);
     explanations_md(&mut o, d);
-    chain_md(&mut o, d);
-    calibration_md(&mut o, d);
-    single_md(&mut o, d);
-    identifiability_md(&mut o, d);
+    where_md(&mut o, d);
+    spread_md(&mut o, d);
+    detectable_md(&mut o, d);
     if !d.notes.is_empty() {
         let _ = writeln!(o, "\nNotes:");
         for n in &d.notes {
@@ -91,18 +89,90 @@ pub fn diagnosis_md(d: &Diagnosis) -> String {
 /// The answer kinds in words.
 pub fn answer_kind(k: AnswerKind) -> &'static str {
     match k {
-        AnswerKind::WithinNoise => "no gap",
+        AnswerKind::NoGap => "no gap",
         AnswerKind::ParametersOff => "parameters off",
         AnswerKind::EffectMissing => "effect missing",
         AnswerKind::Both => "parameters off and effect missing",
-        AnswerKind::PartlyExplained => "partly explained",
         AnswerKind::Unexplained => "unexplained",
         AnswerKind::Ambiguous => "ambiguous",
     }
 }
 
+/// A probability as the report prints it.
+pub fn probability(p: f64) -> String {
+    if (0.995..1.0).contains(&p) {
+        format!("{p:.3}")
+    } else if p < 0.005 && p > 0.0 {
+        format!("{p:.0e}")
+    } else {
+        format!("{p:.2}")
+    }
+}
+
+/// Knobs with values and intervals: `knob = v [lo, hi] unit`.
+pub fn named_values(named: &[Named]) -> String {
+    named
+        .iter()
+        .map(|n| {
+            format!(
+                "{} = {}{} [{}, {}]{}",
+                n.knob,
+                if n.sign_identified { "" } else { "±" },
+                sig(n.value),
+                sig(n.interval[0]),
+                sig(n.interval[1]),
+                if n.unit.is_empty() {
+                    String::new()
+                } else {
+                    format!(" {}", n.unit)
+                }
+            )
+        })
+        .collect::<Vec<_>>()
+        .join("; ")
+}
+
+fn explanations_md(o: &mut String, d: &Diagnosis) {
+    let _ = writeln!(o, "## Explanations, by posterior probability\n");
+    let _ = writeln!(
+        o,
+        "{} explanations weighed, {} confirmed by walks at their most probable point. Values: \
+         most probable, with the 95 % credible interval. A name needs probability ≥ {}; \
+         nothing fits when even the most probable explanation's posterior-predictive p < {}.\n",
+        d.weighed, d.confirmed, d.criterion.decision.threshold, d.criterion.decision.fit_level
+    );
+    let _ = writeln!(
+        o,
+        "| explanation | probability | prior | values | χ² at the mode | fit p |"
+    );
+    let _ = writeln!(o, "|---|---:|---:|---|---:|---:|");
+    for e in &d.explanations {
+        let _ = writeln!(
+            o,
+            "| {} | {} | {} | {} | {}{} | {:.2e} |",
+            e.explanation,
+            probability(e.probability),
+            sig(e.prior),
+            if e.knobs.is_empty() {
+                "–".to_string()
+            } else {
+                named_values(&e.knobs)
+            },
+            sig(e.chi2),
+            if e.walked { "" } else { " (surrogate)" },
+            e.fit_p
+        );
+    }
+    let _ = writeln!(
+        o,
+        "| something outside these | {} | {} | – | – | – |",
+        probability(d.answer.outside),
+        sig(d.criterion.prior.none_of_these)
+    );
+}
+
 fn where_md(o: &mut String, d: &Diagnosis) {
-    let _ = writeln!(o, "## Where the gap lies\n");
+    let _ = writeln!(o, "\n## Where the gap lies\n");
     let _ = writeln!(
         o,
         "| metric | n | RMS z | mean miss | p | trend per doubling of L | per doubling of f | RMS z after |"
@@ -134,201 +204,58 @@ fn where_md(o: &mut String, d: &Diagnosis) {
     }
 }
 
-fn explanations_md(o: &mut String, d: &Diagnosis) {
+fn spread_md(o: &mut String, d: &Diagnosis) {
     let _ = writeln!(
         o,
-        "\n## Competing explanations (each confirmed with walks)\n"
+        "\n## The model's own spread\n\nThe simulator walked again from {} perturbed starts at \
+         every condition; its spread counts beside each measurement's sd.\n",
+        crate::gap::discrepancy::STARTS
     );
     let _ = writeln!(
         o,
-        "Held-out gap: RMS z with every condition predicted by the model fitted to the others. \
-         p: likelihood-ratio test against the nominal, scaled by the over-dispersion left after \
-         the fit.\n"
+        "| block | observations | RMS model sd / measurement sd | largest |"
     );
+    let _ = writeln!(o, "|---|---:|---:|---:|");
+    for b in &d.spread {
+        let _ = writeln!(
+            o,
+            "| {} | {} | {:.2} | {:.2} |",
+            b.block.words(),
+            b.observations,
+            b.rms_ratio,
+            b.max_ratio
+        );
+    }
+}
+
+fn detectable_md(o: &mut String, d: &Diagnosis) {
     let _ = writeln!(
         o,
-        "| model | free | fitted | χ² | held-out gap | shrink | p vs nominal | within noise |"
+        "\n## What these trials can detect\n\nThe value nearest the design's (or the effect's \
+         absence) at which a suspect alone moves the predictions by one standard deviation in \
+         all; smaller changes are not an explanation these trials can tell from nothing.\n"
     );
-    let _ = writeln!(o, "|---|---:|---|---:|---:|---:|---:|---|");
-    for e in &d.explanations {
-        let fitted = if e.knobs.is_empty() {
-            "–".to_string()
-        } else {
-            e.knobs
-                .iter()
-                .map(|(k, v)| format!("{k} = {}", sig(*v)))
-                .collect::<Vec<_>>()
-                .join(", ")
+    let _ = writeln!(o, "| suspect | kind | detectable from |");
+    let _ = writeln!(o, "|---|---|---:|");
+    for k in &d.detectable {
+        let kind = match k.kind {
+            KnobKind::Parameter => "declared parameter",
+            KnobKind::Effect => "effect",
+            KnobKind::Undeclared => "undeclared number",
         };
-        let _ = writeln!(
-            o,
-            "| {} | {} | {} | {:.1} | {:.2} | {:.0} % | {} | {} |",
-            e.model,
-            e.free,
-            fitted,
-            e.chi2,
-            e.gap_held_out,
-            e.shrink_pct,
-            e.p_vs_nominal
-                .map(|p| format!("{p:.1e}"))
-                .unwrap_or_else(|| "–".into()),
-            if e.within_noise { "yes" } else { "no" }
-        );
-    }
-}
-
-fn chain_md(o: &mut String, d: &Diagnosis) {
-    let _ = writeln!(o, "\n## The chain (forward selection)\n");
-    if d.chain.is_empty() {
-        let _ = writeln!(o, "No knob passed the call rules at the first step.");
-        return;
-    }
-    for (i, s) in d.chain.iter().enumerate() {
-        let _ = writeln!(
-            o,
-            "{}. **{}** = {} → held-out gap {:.2} (−{:.0} % at this step, −{:.0} % in all); LR {:.1}, over-dispersion {:.2}, p = {:.1e}{}{}{}; {}",
-            i + 1,
-            s.knob,
-            sig(s.value_si),
-            s.gap_after,
-            s.shrink_pct,
-            s.shrink_total_pct,
-            s.lr,
-            s.dispersion,
-            s.p_value,
-            s.p_value_vs_recalibration
-                .map(|p| format!(", against the recalibration p = {p:.1e}"))
-                .unwrap_or_default(),
-            if s.not_separable_from.is_empty() {
-                String::new()
-            } else {
-                format!("; not separable from {}", s.not_separable_from.join(", "))
-            },
-            s.joint_with
-                .as_ref()
-                .map(|w| format!(
-                    "; joint step with {w} (neither passed alone; LR and p are the pair's, 2 dof)"
-                ))
-                .unwrap_or_default(),
-            if s.within_noise_after {
-                "within noise after"
-            } else {
-                "still beyond noise after"
-            }
-        );
-    }
-    if let Some(last) = d.chain.last() {
-        let _ = writeln!(o, "\nCandidates at the last step:\n");
-        let _ = writeln!(o, "| knob | value | held-out gap | LR | p | verdict |");
-        let _ = writeln!(o, "|---|---:|---:|---:|---:|---|");
-        for c in &last.candidates {
-            let _ = writeln!(
-                o,
-                "| {} | {} | {:.2} | {:.1} | {:.1e} | {} |",
-                c.knob,
-                sig(c.value_si),
-                c.gap_after,
-                c.lr,
-                c.p_value,
-                c.verdict
-            );
-        }
-    }
-}
-
-fn calibration_md(o: &mut String, d: &Diagnosis) {
-    if d.calibration.is_empty() {
-        return;
-    }
-    let _ = writeln!(
-        o,
-        "\n## The best recalibration of the uncertain parameters\n\nWidth: the 95 % interval's share of the plausible range (near 1: these trials do not pin the parameter down).\n"
-    );
-    let _ = writeln!(
-        o,
-        "| parameter | file | recalibrated | 95 % interval | range | move (prior sd) | width | why uncertain |"
-    );
-    let _ = writeln!(o, "|---|---:|---:|---|---|---:|---:|---|");
-    for c in &d.calibration {
-        let _ = writeln!(
-            o,
-            "| {} | {} | {} | {} – {} | {} – {} | {} | {:.2} | {} |",
-            c.parameter,
-            sig(c.nominal),
-            // A magnitude whose sign the trials cannot give (Calibrated::sign_identified).
-            if c.sign_identified {
-                sig(c.value)
-            } else {
-                format!("±{}", sig(c.value))
-            },
-            sig(c.interval[0]),
-            sig(c.interval[1]),
-            sig(c.range[0]),
-            sig(c.range[1]),
-            c.move_in_sd
-                .map(|m| format!("{m:+.1}"))
-                .unwrap_or_else(|| "–".into()),
-            c.width_of_range,
-            c.why.replace('|', "/")
-        );
-    }
-}
-
-fn single_md(o: &mut String, d: &Diagnosis) {
-    let _ = writeln!(
-        o,
-        "\n## Every knob alone (from the nominal, surrogate fit)\n"
-    );
-    let _ = writeln!(
-        o,
-        "| knob | kind | fitted | held-out gap | shrink | LR | p |"
-    );
-    let _ = writeln!(o, "|---|---|---:|---:|---:|---:|---:|");
-    for s in &d.single {
-        let _ = writeln!(
-            o,
-            "| {} | {} | {} {} | {:.2} | {:.0} % | {:.1} | {:.1e} |",
-            s.knob,
-            match s.kind {
-                KnobKind::Parameter => "parameter",
-                KnobKind::Effect => "effect",
-            },
-            sig(s.value),
-            s.unit,
-            s.gap_held_out,
-            s.shrink_pct,
-            s.lr,
-            s.p_value
-        );
-    }
-}
-
-fn identifiability_md(o: &mut String, d: &Diagnosis) {
-    if d.identifiability.is_empty() {
-        return;
-    }
-    let _ = writeln!(o, "\n## Identifiability with these trials\n");
-    let _ = writeln!(
-        o,
-        "| effect | parameter | detected from | identified from | closest mimic | shows in |"
-    );
-    let _ = writeln!(o, "|---|---|---:|---:|---|---|");
-    for i in &d.identifiability {
-        let _ = writeln!(
-            o,
-            "| {} | {} [{}] | {} | {} | {} | {} |",
-            i.effect,
-            i.parameter,
-            i.unit,
-            opt(i.detection_threshold),
-            opt(i.identification_threshold),
-            i.closest_mimic.clone().unwrap_or_else(|| "–".into()),
-            i.identifiable_from
-                .iter()
-                .map(|m| m.column())
-                .collect::<Vec<_>>()
-                .join(", ")
-        );
+        let from = match k.from {
+            Some(v) => format!(
+                "{}{}",
+                sig(v),
+                if k.unit.is_empty() {
+                    String::new()
+                } else {
+                    format!(" {}", k.unit)
+                }
+            ),
+            None => "not in its range".into(),
+        };
+        let _ = writeln!(o, "| {} | {kind} | {from} |", k.knob);
     }
 }
 
@@ -418,17 +345,13 @@ fn draw_residuals<DB: DrawingBackend>(
                 .min(60.0)
                 * 1.1;
             let title = if after {
-                match d.chain.last() {
-                    Some(s) => format!(
-                        "after: {} (held-out RMS z {:.2})",
-                        d.chain
-                            .iter()
-                            .map(|s| s.knob.as_str())
-                            .collect::<Vec<_>>()
-                            .join(" + "),
-                        s.gap_after
+                match d.explanations.first() {
+                    Some(e) if !e.knobs.is_empty() => format!(
+                        "after: {} (probability {})",
+                        e.explanation,
+                        probability(e.probability)
                     ),
-                    None => "after: nothing called".to_string(),
+                    _ => "after: nothing changed".to_string(),
                 }
             } else {
                 format!("nominal model (RMS z {:.2})", d.gap_before)
@@ -490,8 +413,6 @@ fn draw_residuals<DB: DrawingBackend>(
     }
 }
 
-/// The benchmark as Markdown: scores against targets, thresholds, confusion matrices, and
-/// the cases outside the library one by one.
 /// An exploration of the uncertain parameters as markdown.
 pub fn exploration_md(e: &Exploration) -> String {
     let mut o = String::new();
@@ -605,274 +526,52 @@ pub fn exploration_md(e: &Exploration) -> String {
     o
 }
 
-pub fn benchmark_md(b: &BenchmarkSummary, rows: &[CaseRow], command: &str) -> String {
+/// `survey gap suggest` as Markdown.
+pub fn suggestion_md(s: &crate::gap::suggest::Suggestion) -> String {
     let mut o = String::new();
-    let _ = writeln!(
-        o,
-        "# Gap-diagnosis benchmark ({}, {} cases)\n",
-        b.design, b.cases
-    );
-    let _ = writeln!(
-        o,
-        "Generated by `{command}` (resumable and shardable: `--points FILE`, `--shard i/n`, \
-         `--merge`). Rates with their 95 % Clopper–Pearson interval and one-sided 95 % upper \
-         bound. A case *names* a knob when the diagnosis' answer lists it (parameters off, \
-         effect missing, both, or partly explained); an effect whose quantity the design \
-         declares uncertain (friction_coefficient ↔ contact.friction_mu) counts as named when \
-         that parameter is.\n"
-    );
-    scores_md(&mut o, b);
-    thresholds_md(&mut o, b);
-    confusions_md(&mut o, b);
-    outside_cases_md(&mut o, rows);
-    o
-}
-
-/// The score table.
-fn scores_md(o: &mut String, b: &BenchmarkSummary) {
-    let _ = writeln!(o, "## Scores\n");
-    let _ = writeln!(
-        o,
-        "| what | k / n | rate | 95 % interval | upper 95 % | target |"
-    );
-    let _ = writeln!(o, "|---|---:|---:|---|---:|---|");
-    for sc in &b.scores {
-        // No case to count (a run of some kinds only): no rate, rather than "NaN %".
-        if sc.n == 0 {
-            let _ = writeln!(o, "| {} | 0 / 0 | – | – | – | {} |", sc.what, sc.target);
-            continue;
-        }
-        let _ = writeln!(
-            o,
-            "| {} | {} / {} | {:.1} % | {:.1}–{:.1} % | {:.1} % | {} |",
-            sc.what,
-            sc.k,
-            sc.n,
-            sc.rate * 100.0,
-            sc.interval[0] * 100.0,
-            sc.interval[1] * 100.0,
-            sc.upper_95 * 100.0,
-            sc.target
-        );
-    }
-}
-
-/// The identification thresholds, one column per noise level.
-fn thresholds_md(o: &mut String, b: &BenchmarkSummary) {
-    let _ = writeln!(
-        o,
-        "\n## Identification thresholds (SI, {} at 1×: against the other effects, each uncertain parameter, and the recalibration of all of them, confirmed with walks; an effect the design calibrates as a parameter: against the other effects)\n",
-        b.design
-    );
-    let names: Vec<String> = b
-        .thresholds
-        .values()
-        .next()
-        .map(|v| v.iter().map(|(e, _)| e.clone()).collect())
-        .unwrap_or_default();
-    let _ = write!(o, "| effect |");
-    for n in b.thresholds.keys() {
-        let noise: f64 = n.parse().unwrap_or(f64::NAN);
-        let _ = write!(o, " {:.0} % noise |", noise * 100.0);
-    }
-    let _ = writeln!(o);
-    let _ = write!(o, "|---|");
-    for _ in b.thresholds.keys() {
-        let _ = write!(o, "---:|");
-    }
-    let _ = writeln!(o);
-    for e in &names {
-        let _ = write!(o, "| {e} |");
-        for v in b.thresholds.values() {
-            let t = v.iter().find(|(n, _)| n == e).and_then(|(_, t)| *t);
-            let _ = write!(o, " {} |", opt(t));
-        }
-        let _ = writeln!(o);
-    }
-}
-
-/// The confusion matrices.
-fn confusions_md(o: &mut String, b: &BenchmarkSummary) {
-    for c in &b.confusions {
-        let _ = writeln!(
-            o,
-            "\n## Confusion: {} (rows: truth; columns: named first)\n",
-            c.title
-        );
-        let _ = write!(o, "| truth \\ named |");
-        for l in &c.columns {
-            let _ = write!(o, " {l} |");
-        }
-        let _ = writeln!(o);
-        let _ = write!(o, "|---|");
-        for _ in &c.columns {
-            let _ = write!(o, "---:|");
-        }
-        let _ = writeln!(o);
-        for (l, row) in c.rows.iter().zip(&c.counts) {
-            let _ = write!(o, "| {l} |");
-            for v in row {
-                let _ = write!(o, " {v} |");
-            }
-            let _ = writeln!(o);
-        }
-    }
-}
-
-/// Cases outside the single-effect world (parameter errors, Drake, pairs), one per line.
-fn outside_cases_md(o: &mut String, rows: &[CaseRow]) {
-    let listed: Vec<&CaseRow> = rows
+    let _ = writeln!(o, "# Next trials for {}\n", s.design);
+    let leads = s
+        .leading
         .iter()
-        .filter(|r| r.kind != "null" && r.kind != "effect")
-        .collect();
-    if !listed.is_empty() {
+        .map(|(l, p)| format!("{l} ({})", probability(*p)))
+        .collect::<Vec<_>>()
+        .join(", ");
+    let _ = writeln!(
+        o,
+        "Leading explanations: {leads}; the posterior's entropy over them is {:.3} nats. {} of \
+         {} pool conditions offered ({} where an explanation falls, {} where one does not walk \
+         forward{}); new trials at {:.1} % relative sd.\n",
+        s.entropy_now,
+        s.offered,
+        s.pool,
+        s.fell,
+        s.not_forward,
+        if s.any_gait { ", offered anyway" } else { "" },
+        100.0 * s.relative_sd
+    );
+    let _ = writeln!(
+        o,
+        "| trial | L [m] | f [Hz] | amplitude [deg] | mass [kg] | slope [deg] | expected entropy after |"
+    );
+    let _ = writeln!(o, "|---|---:|---:|---:|---:|---:|---:|");
+    for x in &s.suggested {
         let _ = writeln!(
             o,
-            "\n## Cases outside the single-effect world, one by one\n"
+            "| {} | {} | {} | {} | {} | {} | {:.3} |",
+            x.label,
+            sig(x.leg_length_m),
+            sig(x.frequency_hz),
+            x.amplitude_deg.map(sig).unwrap_or_else(|| "–".into()),
+            sig(x.mass_kg),
+            x.slope_deg,
+            x.expected_entropy
         );
+    }
+    if let Some(h) = s.default_entropy {
         let _ = writeln!(
             o,
-            "| case | truth | answer | named | intervals | gap before → after |"
+            "\nOne trial at the design's own condition would leave {h:.3} nats."
         );
-        let _ = writeln!(o, "|---|---|---|---|---|---|");
-        for r in listed {
-            let truth = [r.truth_params.as_str(), r.truth_effects.as_str()]
-                .iter()
-                .filter(|s| !s.is_empty())
-                .copied()
-                .collect::<Vec<_>>()
-                .join("; ");
-            let named = [r.named_params.as_str(), r.named_effects.as_str()]
-                .iter()
-                .filter(|s| !s.is_empty())
-                .copied()
-                .collect::<Vec<_>>()
-                .join("; ");
-            let _ = writeln!(
-                o,
-                "| {} | {} | {} | {} | {} | {:.2} → {} |",
-                r.key,
-                if truth.is_empty() { "none" } else { &truth },
-                r.answer,
-                if named.is_empty() { "–" } else { &named },
-                intervals_cell(&r.intervals),
-                r.gap_before,
-                r.gap_after
-                    .map(|g| format!("{g:.2}"))
-                    .unwrap_or_else(|| "–".into())
-            );
-        }
     }
-}
-
-/// Named intervals `knob=lo..hi;…` as `knob [lo, hi]; …` (the parameter's path without
-/// its design, values to a few significant digits); `–` when none.
-fn intervals_cell(intervals: &str) -> String {
-    if intervals.is_empty() {
-        "–".to_string()
-    } else {
-        intervals
-            .split(';')
-            .map(|iv| match iv.split_once('=') {
-                Some((k, v)) => {
-                    let (lo, hi) = v.split_once("..").unwrap_or((v, v));
-                    let f = |x: &str| x.parse::<f64>().map(sig).unwrap_or_else(|_| x.into());
-                    format!(
-                        "{} [{}, {}]",
-                        k.rsplit(':').next().unwrap_or(k),
-                        f(lo),
-                        f(hi)
-                    )
-                }
-                None => iv.to_string(),
-            })
-            .collect::<Vec<_>>()
-            .join("; ")
-    }
-}
-
-/// The benchmark's confusion matrices as heat maps, one panel each (SVG).
-pub fn confusion_plot(b: &BenchmarkSummary, path: &Path) -> Result<(), PlotError> {
-    register_font();
-    let err = |m: String| PlotError {
-        path: path.display().to_string(),
-        message: m,
-    };
-    let n = b.confusions.len().max(1) as u32;
-    let cols = n.min(3);
-    let rows_n = n.div_ceil(cols);
-    let root = SVGBackend::new(path, (620 * cols, 600 * rows_n)).into_drawing_area();
-    let draw = || -> Result<(), String> {
-        root.fill(&WHITE).map_err(|e| e.to_string())?;
-        let panels = root.split_evenly((rows_n as usize, cols as usize));
-        for (c, area) in b.confusions.iter().zip(panels.iter()) {
-            let (nr, nc) = (c.rows.len().max(1), c.columns.len().max(1));
-            let mut chart = ChartBuilder::on(area)
-                .caption(&c.title, ("sans-serif", 15))
-                .margin(10)
-                .x_label_area_size(170)
-                .y_label_area_size(190)
-                .build_cartesian_2d(0..nc, 0..nr)
-                .map_err(|e| e.to_string())?;
-            let xl = c.columns.clone();
-            let yl = c.rows.clone();
-            chart
-                .configure_mesh()
-                .disable_mesh()
-                .x_labels(nc)
-                .y_labels(nr)
-                .x_label_formatter(&|i| xl.get(*i).cloned().unwrap_or_default())
-                .y_label_formatter(&|i| {
-                    yl.get(nr - 1 - (*i).min(nr - 1))
-                        .cloned()
-                        .unwrap_or_default()
-                })
-                .x_label_style(
-                    ("sans-serif", 10)
-                        .into_font()
-                        .transform(FontTransform::Rotate90),
-                )
-                .y_label_style(("sans-serif", 10))
-                .x_desc("named first")
-                .y_desc("truth")
-                .draw()
-                .map_err(|e| e.to_string())?;
-            for (i, row) in c.counts.iter().enumerate() {
-                let total: usize = row.iter().sum();
-                for (j, v) in row.iter().enumerate() {
-                    let share = if total > 0 {
-                        *v as f64 / total as f64
-                    } else {
-                        0.0
-                    };
-                    let y = nr - 1 - i;
-                    let right = c.columns[j] == c.rows[i]
-                        || (c.rows[i] == "null" && c.columns[j] == "none")
-                        || c.columns[j].ends_with(c.rows[i].split('=').next().unwrap_or("#"));
-                    let color = if right {
-                        RGBColor(44, 160, 44)
-                    } else {
-                        RGBColor(214, 39, 40)
-                    };
-                    chart
-                        .draw_series(std::iter::once(Rectangle::new(
-                            [(j, y), (j + 1, y + 1)],
-                            color.mix(share * 0.9).filled(),
-                        )))
-                        .map_err(|e| e.to_string())?;
-                    if *v > 0 {
-                        chart
-                            .draw_series(std::iter::once(Text::new(
-                                format!("{v}"),
-                                (j, y + 1),
-                                ("sans-serif", 11),
-                            )))
-                            .map_err(|e| e.to_string())?;
-                    }
-                }
-            }
-        }
-        root.present().map_err(|e| e.to_string())
-    };
-    draw().map_err(err)
+    o
 }

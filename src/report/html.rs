@@ -1,6 +1,7 @@
 //! The interactive survey figure: one self-contained HTML page (inline SVG, inline CSS and
 //! a small inline script; nothing fetched at view time) with the three log–log panels of
-//! Table 2. Every robot with both values of a panel is one point, coloured by class;
+//! Table 2 and a fourth of top speed against leg length (with Froude 1, the walk–run limit,
+//! dashed). Every robot with both values of a panel is one point, coloured by class;
 //! robots excluded from the fits are grey and carry their exclusion reason. Each class's
 //! fitted power law is drawn over its data range with the confidence band of the fitted
 //! line (the OLS mean interval of [`crate::regression::predict_ols`], back-transformed).
@@ -9,7 +10,8 @@
 //!
 //! Each point is an SVG `<circle class="pt">` whose `data-*` attributes hold the robot's
 //! id, name, class, fit status, exclusion and its leg length, body length and mass as the
-//! compiled table writes them; the hover tooltip is built from those attributes.
+//! compiled table writes them, and its speeds by kind (`data-speeds-mps`, "top=1.6;…"); the
+//! hover tooltip is built from those attributes (with each speed's Froude number).
 
 use std::fmt::Write as _;
 
@@ -83,19 +85,18 @@ impl Axis {
     }
 }
 
-fn var_label(v: Var) -> &'static str {
-    match v {
-        Var::LegLength => "leg length L [m]",
-        Var::BodyLength => "body length L_B [m]",
-        Var::Mass => "mass m [kg]",
-    }
+/// Axis title: "leg length L [m]", "top speed v [m/s]".
+fn var_label(v: Var) -> String {
+    format!("{} {} [{}]", v.label(), v.symbol(), v.unit())
 }
 
-fn title_case(v: Var) -> &'static str {
-    match v {
-        Var::LegLength => "Leg length",
-        Var::BodyLength => "Body length",
-        Var::Mass => "Mass",
+/// Caption word: "Leg length", "Top speed".
+fn title_case(v: Var) -> String {
+    let label = v.label();
+    let mut chars = label.chars();
+    match chars.next() {
+        Some(c) => c.to_uppercase().chain(chars).collect(),
+        None => String::new(),
     }
 }
 
@@ -105,6 +106,7 @@ fn panel_svg(out: &mut String, index: usize, p: &FigurePanel, confidence: f64) {
     grid_svg(out, &xa, &ya);
     frame_svg(out, p);
     lines_svg(out, index, p, &xa, &ya, confidence);
+    references_svg(out, index, p, &xa, &ya);
     points_svg(out, p, &xa, &ya);
     fits_key(out, p);
     missing_list(out, p);
@@ -142,8 +144,8 @@ fn panel_open(out: &mut String, index: usize, p: &FigurePanel) {
         title_case(p.y),
         p.x.as_str().replace('_', " "),
         esc(&rel),
-        esc(var_label(p.y)),
-        esc(var_label(p.x)),
+        esc(&var_label(p.y)),
+        esc(&var_label(p.x)),
         p.x.as_str(),
         p.y.as_str(),
         esc(&rel)
@@ -210,13 +212,13 @@ fn frame_svg(out: &mut String, p: &FigurePanel) {
         "<text class=\"axis\" x=\"{:.1}\" y=\"{:.1}\" text-anchor=\"middle\">{}</text>",
         (LEFT + W - RIGHT) / 2.0,
         H - 8.0,
-        esc(var_label(p.x))
+        esc(&var_label(p.x))
     );
     let _ = writeln!(
         out,
         "<text class=\"axis\" transform=\"translate(16 {:.1}) rotate(-90)\" text-anchor=\"middle\">{}</text>",
         (TOP + H - BOTTOM) / 2.0,
-        esc(var_label(p.y))
+        esc(&var_label(p.y))
     );
 }
 
@@ -278,6 +280,29 @@ fn lines_svg(
     out.push_str("</g>\n");
 }
 
+/// Reference laws (not fitted), dashed across the panel and clipped to it.
+fn references_svg(out: &mut String, index: usize, p: &FigurePanel, xa: &Axis, ya: &Axis) {
+    if p.references.is_empty() {
+        return;
+    }
+    let _ = writeln!(out, "<g clip-path=\"url(#clip-{index})\">");
+    let (x0, x1) = (10f64.powf(xa.lo), 10f64.powf(xa.hi));
+    for r in &p.references {
+        let _ = writeln!(
+            out,
+            "<line class=\"reference\" data-a=\"{}\" data-b=\"{}\" x1=\"{:.2}\" y1=\"{:.2}\" x2=\"{:.2}\" y2=\"{:.2}\"><title>{}</title></line>",
+            r.a,
+            r.b,
+            xa.px(x0),
+            ya.px(r.a * x0.powf(r.b)),
+            xa.px(x1),
+            ya.px(r.a * x1.powf(r.b)),
+            esc(&r.label)
+        );
+    }
+    out.push_str("</g>\n");
+}
+
 /// The robots (closing the `<svg>`).
 fn points_svg(out: &mut String, p: &FigurePanel, xa: &Axis, ya: &Axis) {
     // Points: excluded (grey) first, fitted on top.
@@ -291,9 +316,15 @@ fn points_svg(out: &mut String, p: &FigurePanel, xa: &Axis, ya: &Axis) {
             "#b4b4b4".to_string()
         };
         let v = |i: usize| q.values[i].as_deref().unwrap_or("");
+        let speeds = q
+            .speeds
+            .iter()
+            .map(|(k, v)| format!("{k}={v}"))
+            .collect::<Vec<_>>()
+            .join(";");
         let _ = writeln!(
             out,
-            "<circle class=\"pt{}\" tabindex=\"0\" cx=\"{:.2}\" cy=\"{:.2}\" r=\"{}\" fill=\"{fill}\" data-id=\"{}\" data-name=\"{}\" data-class=\"{}\" data-class-label=\"{}\" data-fit=\"{}\" data-exclusion=\"{}\" data-leg-length-m=\"{}\" data-body-length-m=\"{}\" data-mass-kg=\"{}\"/>",
+            "<circle class=\"pt{}\" tabindex=\"0\" cx=\"{:.2}\" cy=\"{:.2}\" r=\"{}\" fill=\"{fill}\" data-id=\"{}\" data-name=\"{}\" data-class=\"{}\" data-class-label=\"{}\" data-fit=\"{}\" data-exclusion=\"{}\" data-leg-length-m=\"{}\" data-body-length-m=\"{}\" data-mass-kg=\"{}\" data-speeds-mps=\"{}\"/>",
             if q.fit { "" } else { " excluded" },
             xa.px(q.x),
             ya.px(q.y),
@@ -307,6 +338,7 @@ fn points_svg(out: &mut String, p: &FigurePanel, xa: &Axis, ya: &Axis) {
             esc(v(0)),
             esc(v(1)),
             esc(v(2)),
+            esc(&speeds),
         );
     }
     out.push_str("</g>\n</svg>\n");
@@ -333,6 +365,13 @@ fn fits_key(out: &mut String, p: &FigurePanel) {
             out,
             "<li><span class=\"swatch\"></span>All classes (not drawn): b = {:.2} [{:.2}, {:.2}], R² = {:.3}, n = {}</li>",
             f.b, f.b_ci[0], f.b_ci[1], f.r2, f.n
+        );
+    }
+    for r in &p.references {
+        let _ = writeln!(
+            out,
+            "<li><span class=\"swatch dashed\"></span>{}</li>",
+            esc(&r.label)
         );
     }
     out.push_str("</ul>\n");
@@ -365,7 +404,7 @@ p.meta { font-size: 13px; color: #555; margin: 0 0 10px; }
 .legend { font-size: 13px; margin: 0 0 8px; display: flex; flex-wrap: wrap; gap: 14px; align-items: center; }
 .legend span { display: inline-flex; align-items: center; gap: 5px; }
 .dot { width: 10px; height: 10px; border-radius: 50%; display: inline-block; }
-.panels { display: grid; grid-template-columns: repeat(3, minmax(0, 1fr)); gap: 12px; max-width: 1400px; }
+.panels { display: grid; grid-template-columns: repeat(2, minmax(0, 1fr)); gap: 12px; max-width: 1100px; }
 @media (max-width: 900px) { .panels { grid-template-columns: minmax(0, 1fr); max-width: 560px; } }
 figure.panel { margin: 0; min-width: 0; }
 figcaption { font-weight: bold; font-size: 15px; text-align: center; margin-bottom: 2px; }
@@ -377,6 +416,8 @@ text.axis { font-size: 13px; fill: #222; }
 rect.frame { fill: none; stroke: #666; stroke-width: 1; }
 path.band { fill-opacity: 0.16; stroke: none; }
 line.fit { stroke-width: 2; }
+line.reference { stroke: #555; stroke-width: 1.2; stroke-dasharray: 6 4; }
+.swatch.dashed { border-top: 2px dashed #555; height: 0; }
 circle.pt { stroke: #fff; stroke-width: 0.8; cursor: pointer; }
 circle.pt.excluded { stroke: #777; stroke-width: 0.8; fill-opacity: 0.75; }
 circle.pt:hover, circle.pt:focus, circle.pt.hi { stroke: #000; stroke-width: 2; outline: none; }
@@ -413,6 +454,14 @@ const SCRIPT: &str = r#"
     tip.appendChild(line('leg length L', s.legLengthM, 'm'));
     tip.appendChild(line('body length L_B', s.bodyLengthM, 'm'));
     tip.appendChild(line('mass m', s.massKg, 'kg'));
+    var legM = parseFloat(s.legLengthM);
+    (s.speedsMps || '').split(';').filter(Boolean).forEach(function (kv) {
+      var parts = kv.split('='), v = parseFloat(parts[1]);
+      var d = document.createElement('div');
+      var fr = legM > 0 ? ', Froude ' + (v * v / (9.80665 * legM)).toPrecision(2) : '';
+      d.textContent = parts[0] + ' speed v: ' + parts[1] + ' m/s' + fr;
+      tip.appendChild(d);
+    });
     if (s.fit !== 'true') {
       var e = document.createElement('div');
       e.className = 'ex';
@@ -454,13 +503,13 @@ pub fn survey_html(fig: &SurveyFigure) -> String {
     );
     let _ = writeln!(
         out,
-        "<title>Legged-robot survey, dataset {}: Table 2 power laws</title>",
+        "<title>Legged-robot survey, dataset {}: Table 2 power laws and top speed</title>",
         esc(&fig.version)
     );
     let _ = writeln!(out, "<style>{STYLE}</style>\n</head>\n<body>");
     let _ = writeln!(
         out,
-        "<h1>Allometry of legged robots: the power laws of Table 2</h1>\n<p class=\"meta\">Dataset {} ({}), sha256 <code>{}</code>. {} fit of log<sub>10</sub> y on log<sub>10</sub> x per class{}. Generated by <code>survey fit --out</code>. Hover or focus a point for its values.</p>",
+        "<h1>Allometry of legged robots: the power laws of Table 2 and top speed</h1>\n<p class=\"meta\">Dataset {} ({}), sha256 <code>{}</code>. {} fit of log<sub>10</sub> y on log<sub>10</sub> x per class{}; the speed panel shows each robot's top speed (the highest it is reported to reach), with Froude 1 dashed. Generated by <code>survey fit --out</code>. Hover or focus a point for its values.</p>",
         esc(&fig.version),
         if fig.frozen {
             "frozen release"

@@ -4,9 +4,11 @@
 mod crosscheck;
 mod diff;
 pub mod gap;
+pub mod gap_benchmark;
 pub mod html;
+pub mod interop;
 pub mod plot;
-pub mod separation;
+pub mod speed;
 pub mod study;
 mod ticks;
 pub mod walk_plot;
@@ -355,7 +357,7 @@ pub fn prediction_text(p: &crate::analysis::prediction::Prediction) -> String {
     if let Some(l) = p.leg_length_m {
         out.push_str(&format!("target leg length L = {l} m\n"));
         out.push_str(&format!(
-            "  {:<14} {:>10} {:>10}  {:<24} {:<24} {}\n",
+            "  {:<20} {:>10} {:>10}  {:<24} {:<24} {}\n",
             "quantity",
             "mean",
             "median",
@@ -365,7 +367,7 @@ pub fn prediction_text(p: &crate::analysis::prediction::Prediction) -> String {
         ));
         for q in &p.quantities {
             out.push_str(&format!(
-                "  {:<14} {:>10} {:>10}  {:<24} {:<24} {} = {:.4}·L^{:.3} (R² {:.3}, n {})\n",
+                "  {:<20} {:>10} {:>10}  {:<24} {:<24} {} = {:.4}·L^{:.3} (R² {:.3}, n {})\n",
                 format!("{} [{}]", q.quantity.as_str(), q.unit),
                 sig(q.mean),
                 sig(q.median),
@@ -387,6 +389,19 @@ pub fn prediction_text(p: &crate::analysis::prediction::Prediction) -> String {
                 "  centre: bias-corrected mean (Duan smearing factor {:.3} × median)\n",
                 q.smearing_factor
             ));
+        }
+        if let Some(f) = &p.froude {
+            out.push_str(&format!(
+                "  Froude number v²/(gL) of the {} speed: {} (median {}, {pct:.0}% prediction [{}, {}])\n",
+                p.speed_kind,
+                sig(f.mean),
+                sig(f.median),
+                sig(f.prediction_interval[0]),
+                sig(f.prediction_interval[1])
+            ));
+        }
+        if let Some(why) = &p.speed_unavailable {
+            out.push_str(&format!("  no {} speed predicted: {why}\n", p.speed_kind));
         }
     }
     if let Some(s) = &p.scaled_reference {
@@ -446,30 +461,44 @@ pub fn prediction_text(p: &crate::analysis::prediction::Prediction) -> String {
     out
 }
 
-/// `survey test slope` as text.
+/// `survey test slope` as text: the fit, then one line per hypothesis.
 pub fn slope_test_text(r: &crate::analysis::inference::SlopeTestReport) -> String {
-    format!(
-        "{} {} ∝ {}^b (dataset {}, {}): b = {:.4}, {:.0}% CI [{:.4}, {:.4}], n = {}\nH0: {}: F = {:.4} on (1, {}) df, p = {:.3e}{}\n",
+    let Some(first) = r.tests.first() else {
+        return String::new();
+    };
+    let mut out = format!(
+        "{} {} ∝ {}^b (dataset {}, {}): b = {:.4}, {:.0}% CI [{:.4}, {:.4}], n = {}\n",
         r.class.as_str(),
         r.y.symbol(),
         r.x.symbol(),
         r.dataset.version,
-        r.test.method.label(),
-        r.test.b,
+        first.test.method.label(),
+        first.test.b,
         r.confidence * 100.0,
         r.b_ci[0],
         r.b_ci[1],
-        r.test.n,
-        r.hypothesis,
-        r.test.f_statistic,
-        r.test.df,
-        r.test.p_value,
-        if r.test.p_value < 1.0 - r.confidence {
-            " → rejected"
+        first.test.n,
+    );
+    for t in &r.tests {
+        let h = &t.hypothesis;
+        let name = if h.label == format!("b = {}", h.b) {
+            h.label.clone()
         } else {
-            " → not rejected"
-        }
-    )
+            format!("b = {} ({})", h.b, h.label)
+        };
+        out.push_str(&format!(
+            "H0: {name}: F = {:.4} on (1, {}) df, p = {:.3e}{}\n",
+            t.test.f_statistic,
+            t.test.df,
+            t.test.p_value,
+            if t.rejected {
+                " → rejected"
+            } else {
+                " → not rejected"
+            }
+        ));
+    }
+    out
 }
 
 /// `survey test common-slope` as text.

@@ -40,6 +40,16 @@ pub fn class_color(c: RobotClass) -> RGBColor {
     }
 }
 
+/// How a series' points are drawn.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub enum Marker {
+    #[default]
+    Circle,
+    Square,
+    Triangle,
+    Cross,
+}
+
 /// One series of a log–log panel: points and, optionally, a fitted line y = a·x^b and a band.
 pub struct Series {
     pub label: String,
@@ -50,6 +60,27 @@ pub struct Series {
     pub line_range: Option<(f64, f64)>,
     /// (x, low, high) of a band to shade (e.g. a prediction interval).
     pub band: Vec<(f64, f64, f64)>,
+    pub marker: Marker,
+    /// Draw `line` dashed (a reference rather than a fit).
+    pub dashed: bool,
+    /// Leave the series out of the legend.
+    pub unlabelled: bool,
+}
+
+impl Default for Series {
+    fn default() -> Self {
+        Series {
+            label: String::new(),
+            color: BLACK,
+            points: Vec::new(),
+            line: None,
+            line_range: None,
+            band: Vec::new(),
+            marker: Marker::Circle,
+            dashed: false,
+            unlabelled: false,
+        }
+    }
 }
 
 /// A log–log panel.
@@ -58,6 +89,8 @@ pub struct Panel {
     pub x_label: String,
     pub y_label: String,
     pub series: Vec<Series>,
+    /// Where the legend goes (a corner the data leave free).
+    pub legend: SeriesLabelPosition,
 }
 
 fn bounds(values: impl Iterator<Item = f64>) -> (f64, f64) {
@@ -139,15 +172,33 @@ fn draw_panel<DB: DrawingBackend>(
                 .map_err(|e| e.to_string())?;
         }
         if !s.points.is_empty() {
-            let anno = chart
-                .draw_series(
-                    s.points
-                        .iter()
-                        .map(|&(x, y)| Circle::new((x, y), 4, color.filled())),
-                )
-                .map_err(|e| e.to_string())?;
-            anno.label(&s.label)
-                .legend(move |(x, y)| Circle::new((x + 8, y), 4, color.filled()));
+            // Each marker is its own element type, in data and in legend coordinates: the
+            // macro writes the element once for both.
+            macro_rules! marked {
+                (|$p:ident, $r:ident| $e:expr) => {{
+                    let anno = chart
+                        .draw_series(s.points.iter().map(|&$p| {
+                            let $r: i32 = 4;
+                            $e
+                        }))
+                        .map_err(|e| e.to_string())?;
+                    if !s.unlabelled {
+                        anno.label(&s.label).legend(move |(x, y)| {
+                            let ($p, $r): ((i32, i32), i32) = ((x + 8, y), 4);
+                            $e
+                        });
+                    }
+                }};
+            }
+            match s.marker {
+                Marker::Circle => marked!(|p, r| Circle::new(p, r, color.filled())),
+                Marker::Square => {
+                    marked!(|p, r| EmptyElement::at(p)
+                        + Rectangle::new([(-r, -r), (r, r)], color.filled()))
+                }
+                Marker::Triangle => marked!(|p, r| TriangleMarker::new(p, r + 1, color.filled())),
+                Marker::Cross => marked!(|p, r| Cross::new(p, r, color.stroke_width(2))),
+            }
         }
         if let Some((a, b)) = s.line {
             let (lo, hi) = s.line_range.unwrap_or_else(|| {
@@ -165,10 +216,17 @@ fn draw_panel<DB: DrawingBackend>(
                     let x = lo * (hi / lo).powf(i as f64 / steps as f64);
                     (x, a * x.powf(b))
                 });
-                let drawn = chart
-                    .draw_series(LineSeries::new(line, color.stroke_width(2)))
-                    .map_err(|e| e.to_string())?;
-                if s.points.is_empty() {
+                let line: Vec<(f64, f64)> = line.collect();
+                let drawn = if s.dashed {
+                    chart
+                        .draw_series(DashedLineSeries::new(line, 8, 5, color.stroke_width(2)))
+                        .map_err(|e| e.to_string())?
+                } else {
+                    chart
+                        .draw_series(LineSeries::new(line, color.stroke_width(2)))
+                        .map_err(|e| e.to_string())?
+                };
+                if s.points.is_empty() && !s.unlabelled {
                     drawn.label(&s.label).legend(move |(x, y)| {
                         PathElement::new(vec![(x, y), (x + 16, y)], color.stroke_width(2))
                     });
@@ -181,7 +239,7 @@ fn draw_panel<DB: DrawingBackend>(
         .background_style(WHITE.mix(0.85))
         .border_style(BLACK)
         .label_font(("sans-serif", 13))
-        .position(SeriesLabelPosition::UpperLeft)
+        .position(panel.legend.clone())
         .draw()
         .map_err(|e| e.to_string())?;
     Ok(())
@@ -251,9 +309,11 @@ pub fn survey_panels(table: &SurveyTable, t2: &Table2) -> Vec<Panel> {
                     line: fit.map(|f| (f.a, f.b)),
                     line_range: None,
                     band: Vec::new(),
+                    ..Default::default()
                 }
             })
             .collect(),
+        legend: SeriesLabelPosition::UpperLeft,
     };
     vec![
         panel(Var::Mass, "Mass vs leg length", "mass m [kg]"),
@@ -293,6 +353,7 @@ pub fn prediction_panel(
             line: Some((law.a, law.b)),
             line_range: None,
             band,
+            ..Default::default()
         });
     }
     if let (Some(l), Some(q)) = (
@@ -310,6 +371,7 @@ pub fn prediction_panel(
             line: None,
             line_range: None,
             band: Vec::new(),
+            ..Default::default()
         });
     }
     if let Some(s) = &pred.scaled_reference {
@@ -328,6 +390,7 @@ pub fn prediction_panel(
                 line: Some((r.mass_kg / r.leg_length_m.powf(exp), exp)),
                 line_range: None,
                 band: Vec::new(),
+                ..Default::default()
             });
         }
     }
@@ -339,6 +402,7 @@ pub fn prediction_panel(
         x_label: "leg length L [m]".into(),
         y_label: "mass m [kg]".into(),
         series,
+        legend: SeriesLabelPosition::UpperLeft,
     })
 }
 
@@ -363,7 +427,9 @@ pub fn scaling_panels(s: &crate::study::scaling::ScalingStudy) -> Vec<Panel> {
             line: law.as_ref().map(|l| (l.a, l.b)),
             line_range: None,
             band: Vec::new(),
+            ..Default::default()
         }],
+        legend: SeriesLabelPosition::UpperLeft,
     };
     vec![
         panel(
@@ -379,4 +445,93 @@ pub fn scaling_panels(s: &crate::study::scaling::ScalingStudy) -> Vec<Panel> {
             &s.torque_law,
         ),
     ]
+}
+
+/// The marker of a kind of speed in the Froude figure.
+pub fn kind_marker(kind: crate::dataset::SpeedKind) -> Marker {
+    use crate::dataset::SpeedKind;
+    match kind {
+        SpeedKind::Top => Marker::Circle,
+        SpeedKind::Typical => Marker::Square,
+        SpeedKind::Walking => Marker::Triangle,
+        SpeedKind::Running | SpeedKind::Unstated => Marker::Cross,
+    }
+}
+
+/// The speed report's figure: the Froude number v²/(gL) of every fitted robot's speed
+/// against its leg length, log–log, coloured by class, one marker per kind; Froude 1 (the
+/// walk–run limit) dashed; each class's top-speed fit v = A·L^b drawn as
+/// Fr = (A²/g)·L^(2b − 1), level under dynamic similarity (b = 0.5).
+pub fn froude_panel(r: &crate::analysis::speed::SpeedReport) -> Panel {
+    use crate::dataset::SpeedKind;
+    use crate::dataset::validate::G_MPS2;
+    let fitted: Vec<_> = r.points.iter().filter(|p| p.fit).collect();
+    let (lo, hi) = fitted
+        .iter()
+        .map(|p| p.leg_length_m)
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), l| {
+            (a.min(l), b.max(l))
+        });
+    let mut series = Vec::new();
+    for c in RobotClass::FITTED {
+        let color = class_color(c);
+        let top = r
+            .fits_of(SpeedKind::Top)
+            .and_then(|f| f.group(Group::Class(c)))
+            .and_then(|g| g.fit.as_ref());
+        let mut labelled = top.is_some();
+        for kind in SpeedKind::ALL {
+            let points: Vec<(f64, f64)> = fitted
+                .iter()
+                .filter(|p| p.class == c && p.kind == kind)
+                .map(|p| (p.leg_length_m, p.froude))
+                .collect();
+            if points.is_empty() {
+                continue;
+            }
+            series.push(Series {
+                label: c.label().to_string(),
+                color,
+                points,
+                marker: kind_marker(kind),
+                unlabelled: std::mem::replace(&mut labelled, true),
+                ..Default::default()
+            });
+        }
+        if let Some(f) = top {
+            let range = fitted
+                .iter()
+                .filter(|p| p.class == c && p.kind == SpeedKind::Top)
+                .map(|p| p.leg_length_m)
+                .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), l| {
+                    (a.min(l), b.max(l))
+                });
+            series.push(Series {
+                label: format!("{}: top v ∝ L^{:.2}", c.label(), f.b),
+                color,
+                line: Some((f.a * f.a / G_MPS2, 2.0 * f.b - 1.0)),
+                line_range: Some(range),
+                ..Default::default()
+            });
+        }
+    }
+    if lo.is_finite() && hi > lo {
+        series.push(Series {
+            label: "Froude 1 (walk–run limit)".into(),
+            line: Some((1.0, 0.0)),
+            line_range: Some((lo, hi)),
+            dashed: true,
+            ..Default::default()
+        });
+    }
+    Panel {
+        title: format!(
+            "Froude number vs leg length, dataset {} (● top, ■ typical, ▲ walking, ✕ running or unstated)",
+            r.dataset.version
+        ),
+        x_label: "leg length L [m]".into(),
+        y_label: "Froude number v²/(gL)".into(),
+        series,
+        legend: SeriesLabelPosition::LowerLeft,
+    }
 }

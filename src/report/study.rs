@@ -1,5 +1,6 @@
 //! Table III (minimum torque and gait across scales) as Markdown, LaTeX, CSV and figures.
 
+use plotters::chart::SeriesLabelPosition;
 use plotters::style::RGBColor;
 
 use super::plot::{Panel, Series};
@@ -222,6 +223,7 @@ fn chain_series(
         line: law.map(|l| (l.a, l.b)),
         line_range: None,
         band: Vec::new(),
+        ..Default::default()
     }
 }
 
@@ -269,6 +271,7 @@ pub fn table3_velocity_panels(t: &Table3) -> Vec<Panel> {
                 x_label: "leg length L [m]".into(),
                 y_label: "velocity v [m/s]".into(),
                 series,
+                legend: SeriesLabelPosition::UpperLeft,
             }
         })
         .collect()
@@ -293,6 +296,7 @@ fn reference_line(label: String, a: f64, b: f64, ls: &[f64]) -> Series {
         line: Some((a, b)),
         line_range: Some((lo, hi)),
         band: Vec::new(),
+        ..Default::default()
     }
 }
 
@@ -343,6 +347,7 @@ pub fn table3_torque_panels(t: &Table3) -> Vec<Panel> {
                 x_label: "leg length L [m]".into(),
                 y_label: "τ_min [N·m]".into(),
                 series,
+                legend: SeriesLabelPosition::UpperLeft,
             }
         })
         .collect()
@@ -490,6 +495,7 @@ pub fn feet_panels(f: &crate::study::feet::FeetStudy) -> Vec<Panel> {
                         line: law.map(|l| (l.a, l.b)),
                         line_range: None,
                         band: Vec::new(),
+                        ..Default::default()
                     }
                 })
                 .collect();
@@ -498,6 +504,7 @@ pub fn feet_panels(f: &crate::study::feet::FeetStudy) -> Vec<Panel> {
                 x_label: "leg length L [m]".into(),
                 y_label: "semi-axis [m]".into(),
                 series,
+                legend: SeriesLabelPosition::UpperLeft,
             }
         })
         .collect()
@@ -615,6 +622,7 @@ pub fn torque_check_panels(c: &crate::study::torque_check::TorqueCheck) -> Vec<P
                 line: None,
                 line_range: None,
                 band: Vec::new(),
+                ..Default::default()
             }];
             for (k, l) in b.laws.iter().enumerate() {
                 let p = l.exponent_vs_leg_length;
@@ -625,6 +633,7 @@ pub fn torque_check_panels(c: &crate::study::torque_check::TorqueCheck) -> Vec<P
                     line: Some((c.anchor.stall_torque_nm / c.anchor.leg_length_m.powf(p), p)),
                     line_range: Some((lo, hi)),
                     band: Vec::new(),
+                    ..Default::default()
                 });
             }
             Panel {
@@ -639,6 +648,7 @@ pub fn torque_check_panels(c: &crate::study::torque_check::TorqueCheck) -> Vec<P
                 x_label: "leg length L [m]".into(),
                 y_label: "hip torque [N·m]".into(),
                 series,
+                legend: SeriesLabelPosition::UpperLeft,
             }
         })
         .collect()

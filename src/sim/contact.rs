@@ -93,6 +93,37 @@ fn is_zero(x: &f64) -> bool {
     *x == 0.0
 }
 
+/// Depth [m] at which one upright ellipsoid foot (semi-axes `semi`, vertical last) carries
+/// `load_n` under p = E(1 − r): (π/3)·E·a·b·(1 − r₀)²(1 + 2r₀) = load with r₀ = 1 − δ/c,
+/// by bisection (the closed form of [`patch`] for an upright foot).
+pub fn upright_sinkage_m(modulus_pa: f64, semi: [f64; 3], load_n: f64) -> f64 {
+    let force = |d: f64| {
+        let r0 = (1.0 - d / semi[2]).max(0.0);
+        std::f64::consts::FRAC_PI_3
+            * modulus_pa
+            * semi[0]
+            * semi[1]
+            * (1.0 - r0).powi(2)
+            * (1.0 + 2.0 * r0)
+    };
+    let (mut lo, mut hi) = (0.0, semi[2]);
+    for _ in 0..200 {
+        let mid = 0.5 * (lo + hi);
+        if force(mid) < load_n {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    0.5 * (lo + hi)
+}
+
+/// dF/dδ [N/m] of one upright ellipsoid foot pressed by `depth_m`: 2π·E·a·b·r₀(1 − r₀)/c.
+pub fn upright_stiffness_n_per_m(modulus_pa: f64, semi: [f64; 3], depth_m: f64) -> f64 {
+    let r0 = (1.0 - depth_m / semi[2]).max(0.0);
+    2.0 * std::f64::consts::PI * modulus_pa * semi[0] * semi[1] * r0 * (1.0 - r0) / semi[2]
+}
+
 /// Radial Gauss–Legendre nodes/weights on ξ ∈ [0, 1] (3 points).
 const GL_NODES: [f64; 3] = [0.112_701_665_379_258_3, 0.5, 0.887_298_334_620_741_7];
 const GL_WEIGHTS: [f64; 3] = [

@@ -18,7 +18,7 @@ use super::state::State;
 /// Built-in designs: (name, path in the repository, text). Bundled so the binary works
 /// from any directory. The `-ref` designs are ../shared/research/walker-models.json in this
 /// schema: the models of the Drake cross-check (reports/drake-crosscheck.md).
-pub const BUILTIN_DESIGNS: [(&str, &str, &str); 7] = [
+pub const BUILTIN_DESIGNS: [(&str, &str, &str); 8] = [
     (
         "mugatu",
         "dataset/walkers/mugatu.toml",
@@ -33,6 +33,11 @@ pub const BUILTIN_DESIGNS: [(&str, &str, &str); 7] = [
         "zippy-spherical",
         "dataset/walkers/zippy-spherical.toml",
         include_str!("../../dataset/walkers/zippy-spherical.toml"),
+    ),
+    (
+        "mugatu-lab",
+        "dataset/walkers/mugatu-lab.toml",
+        include_str!("../../dataset/walkers/mugatu-lab.toml"),
     ),
     (
         "mugatu-ref",
@@ -271,6 +276,28 @@ pub struct Design {
     /// (`survey gap diagnose --audit-undeclared`). Not physics either.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub audit: Option<AuditSpec>,
+    /// Where the design was read from (a file path, or a bundled design's path), for error
+    /// messages about it; None for a design built in code. Not part of the design's data:
+    /// never serialised, and ignored by equality.
+    #[serde(skip)]
+    pub origin: Option<DesignOrigin>,
+}
+
+/// Where a design came from (see [`Design::origin`]): compares equal to any other, so two
+/// designs with the same values are equal wherever they were read.
+#[derive(Clone, Debug, Default)]
+pub struct DesignOrigin(pub String);
+
+impl PartialEq for DesignOrigin {
+    fn eq(&self, _: &DesignOrigin) -> bool {
+        true
+    }
+}
+
+impl std::fmt::Display for DesignOrigin {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(&self.0)
+    }
 }
 
 /// The undeclared-parameter audit of a design: every number of its physical sections
@@ -445,10 +472,11 @@ impl FieldCheck<'_> {
 impl Design {
     /// Parses and validates a design; `origin` (file name) appears in error messages.
     pub fn from_toml_str(text: &str, origin: &str) -> Result<Design, SimError> {
-        let d: Design = toml::from_str(text).map_err(|e| SimError::Parse {
+        let mut d: Design = toml::from_str(text).map_err(|e| SimError::Parse {
             origin: origin.to_string(),
             message: e.to_string(),
         })?;
+        d.origin = Some(DesignOrigin(origin.to_string()));
         d.validate(origin)?;
         d.check_uncertain(origin)?;
         d.check_direction(origin)?;
@@ -832,12 +860,13 @@ impl Design {
             *number_at(&mut tree, path).map_err(|reason| self.bad_path(path, reason))? =
                 toml::Value::Float(*value);
         }
-        let d: Design = tree
+        let mut d: Design = tree
             .try_into()
             .map_err(|e: toml::de::Error| SimError::Parse {
                 origin: self.name.clone(),
                 message: e.message().to_string(),
             })?;
+        d.origin = self.origin.clone();
         d.validate(&self.name)?;
         Ok(d)
     }
@@ -1076,6 +1105,15 @@ impl Design {
             });
         }
         Ok(out)
+    }
+
+    /// The file (or bundled path) the design was read from, else its name: what an error
+    /// about the design names.
+    pub fn origin_name(&self) -> String {
+        self.origin
+            .as_ref()
+            .map(|o| o.0.clone())
+            .unwrap_or_else(|| self.name.clone())
     }
 
     pub fn leg_length_m(&self) -> f64 {

@@ -28,7 +28,7 @@ pub enum SimError {
     },
     /// A design name that is neither built in nor an existing file.
     #[error(
-        "unknown design `{0}`: expected one of mugatu, zippy, zippy-spherical, mugatu-ref, mugatu-ref-sap, zippy-ref, zippy-spherical-ref or a path to a .toml file"
+        "unknown design `{0}`: expected one of mugatu, zippy, zippy-spherical, mugatu-lab, mugatu-ref, mugatu-ref-sap, zippy-ref, zippy-spherical-ref or a path to a .toml file"
     )]
     UnknownDesign(String),
     /// Bad option passed to a walk (e.g. negative duration).

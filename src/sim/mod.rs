@@ -31,9 +31,12 @@ pub mod walk;
 
 pub use contact::{
     ContactParams, Cut, Patch, PatchWrench, patch, patch_forces, patch_into, patch_wrench,
+    upright_sinkage_m, upright_stiffness_n_per_m,
 };
 pub use control::{Command, Controller};
-pub use design::{BUILTIN_DESIGNS, Design, FrictionCone, MIRROR_ODD_PATHS, WalkingDirection};
+pub use design::{
+    BUILTIN_DESIGNS, Design, DesignOrigin, FrictionCone, MIRROR_ODD_PATHS, WalkingDirection,
+};
 pub use effects::{Effect, EffectContext, EffectSpec, GeneralizedForce};
 pub use error::SimError;
 pub use model::{Energy, FootSection, GRAVITY_MPS2, Hardstop, Leg, Model, Simulator, StepInfo};

@@ -209,13 +209,14 @@ pub fn prepare_walk(design: &Design, opts: &WalkOptions) -> Result<WalkSetup, Si
     let dt = d.numerics.time_step_s;
     let limit = stable_time_step_s(&d);
     if dt > limit {
-        return Err(SimError::InvalidOption {
-            option: "numerics.time_step_s".into(),
+        return Err(SimError::InvalidValue {
+            origin: d.origin_name(),
+            field: "numerics.time_step_s".into(),
+            value: format!("{dt} s (at L = {} m)", d.geometry.leg_length_m),
             reason: format!(
-                "{dt} s (at L = {} m) is beyond the stable limit {limit:.3e} s of the foot contact: \
-                 a foot carrying the weight (E = {} Pa, m = {} kg) vibrates at {:.1} Hz, and the \
-                 step must resolve it (ω·dt ≤ {MAX_CONTACT_OMEGA_DT}); reduce the time step",
-                d.geometry.leg_length_m,
+                "beyond the stable limit {limit:.3e} s of the foot contact: a foot carrying the weight \
+                 (E = {} Pa, m = {} kg) vibrates at {:.1} Hz, and the step must resolve it \
+                 (ω·dt ≤ {MAX_CONTACT_OMEGA_DT}); reduce the time step",
                 d.contact.hydroelastic_modulus_pa,
                 d.mass.total_mass_kg,
                 MAX_CONTACT_OMEGA_DT / limit / std::f64::consts::TAU

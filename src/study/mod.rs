@@ -6,8 +6,10 @@
 //! * [`table3`]: the paper's Table III — minimum torque and gait over 0.02–1.2 m, both mass
 //!   laws, fitted power laws.
 //! * [`feet`]: the foot study — each semi-axis scaled 0.5–2.0× at three sizes.
+//! * [`bench`]: the simulator's speed on one design, one thread and every core (`sim bench`).
 //! * [`sweep`]: points files that make sweeps resumable and shardable, and their merge.
 
+pub mod bench;
 pub mod error;
 pub mod feet;
 pub mod min_torque;

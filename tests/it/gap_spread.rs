@@ -1,9 +1,11 @@
-//! The model's own trial-to-trial spread (`--model-spread`, `gap::diagnose::model_spread`):
+//! The model's own trial-to-trial spread (`gap::discrepancy::model_spread`, counted in every
+//! diagnosis' likelihood):
 //! the sd of a condition's metrics over walks from perturbed starts, checked against walks
 //! made independently through the simulator's API, and exactly zero when the design's
 //! start is not perturbed.
 
-use robot_survey::gap::diagnose::model_spread;
+use robot_survey::gap::cache::SimCache;
+use robot_survey::gap::discrepancy::model_spread;
 use robot_survey::gap::knob::ModelSetting;
 use robot_survey::gap::simulate::resolve;
 use robot_survey::gap::trials::Metric;
@@ -24,7 +26,14 @@ fn the_model_spread_is_the_sd_of_walks_from_perturbed_starts() {
     )
     .expect("trials");
     let conditions = resolve(&set).expect("conditions");
-    let spread = model_spread(&conditions, &lib, 3).expect("walks");
+    let spread = model_spread(
+        &conditions,
+        &lib,
+        &ModelSetting::nominal(),
+        3,
+        &SimCache::default(),
+    )
+    .expect("walks");
 
     // Independently: the design at the condition walked through the simulator's API for the
     // diagnosis' 16 drive cycles, from the unperturbed start and from seeds 1, 2, 3; the
@@ -84,6 +93,13 @@ fn an_unperturbed_start_has_no_spread() {
         .expect("trials");
     let conditions = resolve(&set).expect("conditions");
     // Every seed then starts from the same state: the same walk, bit for bit.
-    let spread = model_spread(&conditions, &lib, 2).expect("walks");
-    assert_eq!(spread[0], [0.0; 8]);
+    let spread = model_spread(
+        &conditions,
+        &lib,
+        &ModelSetting::nominal(),
+        2,
+        &SimCache::default(),
+    )
+    .expect("walks");
+    assert_eq!(spread[0], vec![0.0; 8]);
 }

@@ -8,10 +8,11 @@ use std::path::Path;
 
 use crate::common;
 
-const PAIRS: [(&str, &str); 3] = [
+const PAIRS: [(&str, &str); 4] = [
     ("leg_length", "body_length"),
     ("leg_length", "mass"),
     ("body_length", "mass"),
+    ("leg_length", "speed_top"),
 ];
 const CLASSES: [&str; 4] = ["lower-biped", "full-biped", "quadruped", "hexapod"];
 
@@ -20,6 +21,7 @@ fn field(var: &str) -> &'static str {
         "leg_length" => "leg_length_m",
         "body_length" => "body_length_m",
         "mass" => "mass_kg",
+        "speed_top" => "speed_top_mps",
         other => panic!("unknown variable {other}"),
     }
 }
@@ -47,7 +49,7 @@ fn records(dir: &Path) -> BTreeMap<String, Rec> {
             .unwrap_or_else(|e| panic!("{}: {e}", p.display()));
         let s = |k: &str| t.get(k).and_then(|v| v.as_str()).unwrap_or("").to_string();
         let mut values = BTreeMap::new();
-        for f in ["leg_length_m", "body_length_m", "mass_kg"] {
+        for f in ["leg_length_m", "body_length_m", "mass_kg", "speed_top_mps"] {
             let v = t
                 .get("values")
                 .and_then(|v| v.get(f))
@@ -144,7 +146,7 @@ fn check_page(html: &str, dataset: &Path) {
             .map(|p| (p.0.as_str(), p.1.as_str()))
             .collect::<Vec<_>>(),
         PAIRS.to_vec(),
-        "three panels in Table 2's order"
+        "Table 2's three panels in order, then top speed"
     );
     let mut plotted = BTreeMap::<&str, usize>::new();
     for (x, y, p) in &ps {
@@ -178,6 +180,15 @@ fn check_page(html: &str, dataset: &Path) {
                     None => assert_eq!(got, "", "{id} {f}: record has no value"),
                 }
             }
+            // The speeds the tooltip lists: the top speed as the record gives it.
+            let speeds = a["data-speeds-mps"].as_str();
+            match r.values.get("speed_top_mps") {
+                Some(v) => assert!(
+                    speeds.split(';').any(|kv| kv == format!("top={v}")),
+                    "{id}: speeds `{speeds}` lack top={v}"
+                ),
+                None => assert!(!speeds.contains("top="), "{id}: no top speed in its record"),
+            }
         }
         for (id, r) in &recs {
             let shown = r.values.get(fx).is_some_and(|v| *v > 0.0)
@@ -206,6 +217,15 @@ fn check_page(html: &str, dataset: &Path) {
                 .filter(|r| r.fit && r.class == class)
                 .filter_map(|r| Some((*r.values.get(fx)?, *r.values.get(fy)?)))
                 .collect();
+            // A class is fitted (and drawn) with at least 3 robots.
+            if pts.len() < 3 {
+                assert!(
+                    !lines.iter().any(|l| l["data-class"] == class),
+                    "{y}~{x}: a {class} line from {} robots",
+                    pts.len()
+                );
+                continue;
+            }
             let line = lines
                 .iter()
                 .find(|l| l["data-class"] == class)
@@ -282,7 +302,11 @@ mass_kg = { value = 7.5, source = "spec" }
     check_self_contained(&html);
     check_page(&html, data.path());
     let escaped = "data-name=\"Quad &lt;&quot;test&quot;&gt; &amp; co\"";
-    assert_eq!(html.matches(escaped).count(), 3, "one point per panel");
+    assert_eq!(
+        html.matches(escaped).count(),
+        3,
+        "one point per size panel (it has no top speed)"
+    );
     let leftovers: Vec<_> = std::fs::read_dir(out_dir.path())
         .expect("out")
         .map(|e| e.expect("entry").file_name().to_string_lossy().into_owned())

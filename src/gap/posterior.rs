@@ -1,0 +1,681 @@
+//! The posterior over explanations, and the search that makes it trustworthy.
+//!
+//! The criterion is fixed: P(H | trials) ∝ P(H) · Z_H ([`super::hypothesis`],
+//! [`super::evidence`]). The search only decides how well each Z_H is computed, by refining
+//! the surrogate with real walks where the leading explanations' posteriors lie:
+//!
+//! 1. every explanation is integrated on the additive surrogate;
+//! 2. the leading single explanations are *refined*: walks at the mode and one posterior
+//!    width either side become nodes of the knob's curve, until the mode stops moving (a
+//!    knife-edge gait needs several rounds);
+//! 3. when the best explanation so far does not reach the threshold or fails the
+//!    posterior-predictive check, every other suspect's curve is walked again with the best
+//!    single's knob held at its mode ([`super::surrogate::Anchored`]): pairs holding it then
+//!    see how the two interact;
+//! 4. the leading pairs are *confirmed*: walks at the mode and one step along each knob give
+//!    a first-order correction, until the mode stops moving.
+//!
+//! What the search can miss is an explanation ranked too low to be refined or confirmed;
+//! [`Search::exhaustive`] refines and confirms every one, which is how the misses are
+//! measured (reports/gap-benchmark.md).
+
+use rayon::prelude::*;
+
+use super::cache::SimCache;
+use super::criterion::{Criterion, Decision};
+use super::error::GapError;
+use super::evidence::{Discrepancy, Evidence, Slab, Target, evidence};
+use super::hypothesis::{Class, Hypothesis};
+use super::knob::Knobs;
+use super::library::EffectLibrary;
+use super::likelihood::{Observation, chi2_of, log_normaliser};
+use super::simulate::{Condition, Walked};
+use super::surrogate::{Anchored, Correction, Surrogate};
+use crate::progress::Observer;
+
+/// How hard the search works (none of it changes the criterion).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Search {
+    /// Single explanations refined, and pairs confirmed, at most (the most probable first).
+    pub confirm: usize,
+    /// An explanation is refined or confirmed only while its probability is at least this
+    /// share of the most probable one's.
+    pub share: f64,
+    /// Walk-and-refit rounds per explanation.
+    pub rounds: usize,
+    /// Refine and confirm every explanation (to measure what the search misses).
+    pub exhaustive: bool,
+}
+
+impl Default for Search {
+    fn default() -> Self {
+        Search {
+            confirm: 6,
+            share: 0.01,
+            rounds: 5,
+            exhaustive: false,
+        }
+    }
+}
+
+/// What the posterior needs besides the surrogate it refines.
+pub struct Inputs<'a> {
+    pub conditions: &'a [Condition],
+    pub lib: &'a EffectLibrary,
+    pub cache: &'a SimCache,
+    pub knobs: &'a Knobs,
+    pub obs: &'a [Observation],
+    pub progress: &'a dyn Observer,
+}
+
+/// One explanation, weighed.
+#[derive(Clone, Debug)]
+pub struct Weighed {
+    pub hypothesis: Hypothesis,
+    pub evidence: Evidence,
+    /// The walks' first-order correction of the surrogate at the mode (pairs).
+    pub correction: Option<Correction>,
+    /// Real walks at the mode, and their χ² (None: not walked).
+    pub walks: Option<Vec<Walked>>,
+    pub walked_chi2: Option<f64>,
+    /// The observations with the model's own spread at the mode (None: the nominal's).
+    pub obs: Option<Vec<Observation>>,
+    /// ln of the Bayes factor of this explanation with "something outside these" beside it
+    /// over it alone, at its most probable point.
+    pub log_bf: f64,
+    pub probability: f64,
+}
+
+/// The posterior: every explanation weighed, most probable first, and "something outside
+/// these".
+#[derive(Clone, Debug)]
+pub struct Posterior {
+    pub weighed: Vec<Weighed>,
+    /// "Something outside these": its evidence, prior and probability (None: the trials
+    /// leave it no range).
+    pub outside: Option<(Evidence, f64, f64)>,
+    /// The knob the other suspects' curves were walked again about, and its value.
+    pub anchor: Option<(usize, f64)>,
+}
+
+impl Posterior {
+    /// The most probable explanation that is not "something outside these".
+    pub fn best(&self) -> Option<&Weighed> {
+        self.weighed.first()
+    }
+}
+
+/// A deterministic seed of an explanation's importance samples.
+fn seed_of(free: &[usize]) -> u64 {
+    free.iter().fold(0x9e37_79b9_7f4a_7c15_u64, |h, k| {
+        (h ^ (*k as u64)).wrapping_mul(0x0000_0100_0000_01b3)
+    })
+}
+
+/// The search's state: the surrogate it refines, the slabs on it, the explanations.
+struct State {
+    surrogate: Surrogate,
+    slabs: Vec<Slab>,
+    weighed: Vec<Weighed>,
+    outside: Option<(Evidence, f64, f64)>,
+    /// "Something outside these" beside an explanation, and its prior.
+    discrepancy: Option<Discrepancy>,
+    outside_prior: f64,
+    log_norm: f64,
+}
+
+impl State {
+    /// Every explanation's Bayes factor with "something outside these" beside it, at its
+    /// most probable point: walked predictions where the search walked it (and its
+    /// observations with the model's spread there), else the surrogate's.
+    fn bayes_factors(&mut self, inp: &Inputs<'_>) {
+        let Some(d) = &self.discrepancy else { return };
+        let bfs: Vec<f64> = self
+            .weighed
+            .par_iter()
+            .map(|w| {
+                let obs = w.obs.as_deref().unwrap_or(inp.obs);
+                let pred = self.predictions(inp, w);
+                d.log_bayes_factor(obs, &pred)
+            })
+            .collect();
+        for (w, bf) in self.weighed.iter_mut().zip(bfs) {
+            w.log_bf = bf;
+        }
+    }
+
+    /// An explanation's predictions of every observation at its most probable point.
+    fn predictions(&self, inp: &Inputs<'_>, w: &Weighed) -> Vec<f64> {
+        if let Some(walks) = &w.walks {
+            return inp
+                .obs
+                .iter()
+                .map(|o| walks[o.trial].channel(o.channel))
+                .collect();
+        }
+        if w.evidence.mode.iter().any(|v| !v.is_finite()) {
+            return vec![f64::NAN; inp.obs.len()];
+        }
+        let set = inp.knobs.set_of(&w.hypothesis.knobs, &w.evidence.mode);
+        inp.obs
+            .iter()
+            .map(|o| {
+                self.surrogate
+                    .predict(o.trial, o.channel, &set, w.correction.as_ref())
+            })
+            .collect()
+    }
+
+    /// "Something outside these" beside the most probable explanation, for the report: κ's
+    /// posterior there, its prior and its probability (all explanations' share).
+    fn outside_of_best(&self, inp: &Inputs<'_>) -> Option<(Evidence, f64, f64)> {
+        let d = self.discrepancy.as_ref()?;
+        let best = self.weighed.first()?;
+        let obs = best.obs.as_deref().unwrap_or(inp.obs);
+        let e = d.posterior(obs, &self.predictions(inp, best));
+        let lib: f64 = self.weighed.iter().map(|w| w.probability).sum();
+        Some((e, self.outside_prior, (1.0 - lib).max(0.0)))
+    }
+
+    /// The explanations not yet integrated, "something outside these" (its prior the
+    /// hypothesis' of that class, its reach `max_relative`) on the nominal.
+    fn new(
+        inp: &Inputs<'_>,
+        surrogate: Surrogate,
+        slabs: Vec<Slab>,
+        hypotheses: Vec<Hypothesis>,
+        max_relative: f64,
+    ) -> State {
+        let discrepancy = Discrepancy::new(inp.obs, &surrogate.nominal, max_relative);
+        let (outside, hypotheses): (Vec<Hypothesis>, Vec<Hypothesis>) = hypotheses
+            .into_iter()
+            .partition(|h| h.class == Class::NoneOfThese);
+        let weighed = hypotheses
+            .into_iter()
+            .map(|h| Weighed {
+                hypothesis: h,
+                evidence: Evidence::empty(0),
+                correction: None,
+                walks: None,
+                walked_chi2: None,
+                obs: None,
+                log_bf: f64::NEG_INFINITY,
+                probability: 0.0,
+            })
+            .collect();
+        State {
+            surrogate,
+            slabs,
+            weighed,
+            outside: None,
+            discrepancy,
+            outside_prior: outside.first().map_or(0.0, |h| h.prior),
+            log_norm: log_normaliser(inp.obs),
+        }
+    }
+
+    fn integrate(&self, inp: &Inputs<'_>, free: &[usize], c: Option<&Correction>) -> Evidence {
+        self.integrate_on(inp, inp.obs, self.log_norm, free, c)
+    }
+
+    fn integrate_on(
+        &self,
+        inp: &Inputs<'_>,
+        obs: &[Observation],
+        log_norm: f64,
+        free: &[usize],
+        c: Option<&Correction>,
+    ) -> Evidence {
+        let t = Target {
+            surrogate: &self.surrogate,
+            knobs: inp.knobs,
+            obs,
+            free,
+            slabs: &self.slabs,
+            correction: c,
+            log_norm,
+        };
+        evidence(&t, seed_of(free))
+    }
+
+    /// Counts the model's own spread at explanation `i`'s mode (perturbed starts there) in
+    /// its likelihood, and integrates it again with it.
+    fn spread_at_mode(&mut self, inp: &Inputs<'_>, i: usize) -> Result<(), GapError> {
+        let w = &self.weighed[i];
+        let free = w.hypothesis.knobs.clone();
+        if w.evidence.mode.iter().any(|v| !v.is_finite()) {
+            return Ok(());
+        }
+        let setting = inp
+            .knobs
+            .setting_at(inp.lib, &inp.knobs.set_of(&free, &w.evidence.mode));
+        let spread = super::discrepancy::model_spread(
+            inp.conditions,
+            inp.lib,
+            &setting,
+            super::discrepancy::STARTS,
+            inp.cache,
+        )?;
+        let mut obs = inp.obs.to_vec();
+        super::discrepancy::apply(&mut obs, &spread);
+        let log_norm = log_normaliser(&obs);
+        let e = self.integrate_on(inp, &obs, log_norm, &free, w.correction.as_ref());
+        let w = &mut self.weighed[i];
+        if let Some(walks) = &w.walks {
+            w.walked_chi2 = Some(chi2_of(&obs, walks));
+        }
+        w.evidence = e;
+        w.obs = Some(obs);
+        Ok(())
+    }
+
+    /// Integrates again every explanation holding one of `knobs` (all when empty) that has
+    /// no correction of its own.
+    fn reintegrate(&mut self, inp: &Inputs<'_>, knobs: &[usize]) {
+        self.reintegrate_where(inp, |h| {
+            !h.is_empty() && (knobs.is_empty() || h.iter().any(|k| knobs.contains(k)))
+        });
+    }
+
+    /// Integrates again every explanation without a correction of its own whose knobs
+    /// `pick` takes.
+    fn reintegrate_where(&mut self, inp: &Inputs<'_>, pick: impl Fn(&[usize]) -> bool) {
+        let todo: Vec<usize> = (0..self.weighed.len())
+            .filter(|&i| {
+                self.weighed[i].correction.is_none() && pick(&self.weighed[i].hypothesis.knobs)
+            })
+            .collect();
+        let fresh: Vec<Evidence> = todo
+            .par_iter()
+            .map(|&i| self.integrate_own(inp, i))
+            .collect();
+        for (i, e) in todo.into_iter().zip(fresh) {
+            self.weighed[i].evidence = e;
+        }
+    }
+
+    /// Explanation `i` integrated on its own observations (the model's spread at its mode,
+    /// when counted) and correction.
+    fn integrate_own(&self, inp: &Inputs<'_>, i: usize) -> Evidence {
+        let w = &self.weighed[i];
+        match &w.obs {
+            Some(obs) => self.integrate_on(
+                inp,
+                obs,
+                log_normaliser(obs),
+                &w.hypothesis.knobs,
+                w.correction.as_ref(),
+            ),
+            None => self.integrate(inp, &w.hypothesis.knobs, w.correction.as_ref()),
+        }
+    }
+
+    fn normalise(&mut self, inp: &Inputs<'_>) {
+        self.bayes_factors(inp);
+        normalise(&mut self.weighed, self.outside_prior);
+        self.outside = self.outside_of_best(inp);
+    }
+
+    /// Runs `step` on each explanation of `indices` (found again by its knobs, as a step
+    /// may reorder the list): `step(state, its index now, its knobs)`.
+    fn for_each(
+        &mut self,
+        indices: &[usize],
+        mut step: impl FnMut(&mut State, usize, &[usize]) -> Result<(), GapError>,
+    ) -> Result<(), GapError> {
+        let keys: Vec<Vec<usize>> = indices
+            .iter()
+            .map(|&i| self.weighed[i].hypothesis.knobs.clone())
+            .collect();
+        for key in keys {
+            if let Some(i) = self.weighed.iter().position(|w| w.hypothesis.knobs == key) {
+                step(self, i, &key)?;
+            }
+        }
+        Ok(())
+    }
+
+    /// Indices of the most probable explanations of `len` knobs not yet walked whose
+    /// probability is at least `share` of the most probable explanation of that size — and,
+    /// when an explanation already stands (`settled`: it reaches the threshold and fits), of
+    /// that one's — at most `search.confirm`; all with `exhaustive`.
+    fn leading(&self, len: usize, search: &Search, settled: bool) -> Vec<usize> {
+        let of_len: Vec<usize> = (0..self.weighed.len())
+            .filter(|&i| self.weighed[i].hypothesis.knobs.len() == len)
+            .collect();
+        let mut top = of_len.first().map_or(0.0, |&i| self.weighed[i].probability);
+        if settled {
+            top = top.max(self.weighed.first().map_or(0.0, |w| w.probability));
+        }
+        of_len
+            .into_iter()
+            .filter(|&i| self.weighed[i].walks.is_none())
+            .filter(|&i| search.exhaustive || self.weighed[i].probability >= search.share * top)
+            .take(if search.exhaustive {
+                usize::MAX
+            } else {
+                search.confirm
+            })
+            .collect()
+    }
+}
+
+impl Inputs<'_> {
+    /// Real walks with the knobs of `set` at their coordinates.
+    fn walks(&self, set: &[(usize, f64)]) -> Result<Vec<Walked>, GapError> {
+        let clamped: Vec<(usize, f64)> = set
+            .iter()
+            .map(|&(k, x)| (k, x.clamp(self.knobs.list[k].lo, self.knobs.list[k].hi)))
+            .collect();
+        let setting = self.knobs.setting_at(self.lib, &clamped);
+        self.cache
+            .get(self.conditions, self.lib, &setting, self.progress)
+    }
+}
+
+/// One posterior width along each free knob of an evidence (unit coordinates), kept between
+/// 1/1024 and 1/32 of the range.
+fn widths(e: &Evidence) -> Vec<f64> {
+    e.intervals
+        .iter()
+        .map(|[a, b]| {
+            let w = (b - a) / 4.0;
+            if w.is_finite() {
+                w.clamp(1.0 / 1024.0, 1.0 / 32.0)
+            } else {
+                1.0 / 32.0
+            }
+        })
+        .collect()
+}
+
+/// Refines single explanation `i`: walks at its mode and a posterior width either side
+/// become nodes of its knob's curve; integrate again; repeat while the mode moves by more than
+/// a quarter of the posterior's width.
+fn refine_single(
+    inp: &Inputs<'_>,
+    st: &mut State,
+    i: usize,
+    rounds: usize,
+) -> Result<(), GapError> {
+    let k = st.weighed[i].hypothesis.knobs[0];
+    let knob = &inp.knobs.list[k];
+    for round in 0..rounds {
+        let e = &st.weighed[i].evidence;
+        let (u, w) = (e.mode[0], widths(e)[0]);
+        if !u.is_finite() {
+            break;
+        }
+        let sides: &[f64] = if round == 0 {
+            &[0.0, -1.0, 1.0]
+        } else {
+            &[-1.0, 1.0]
+        };
+        for side in sides {
+            let x = knob.from_unit((u + side * w).clamp(0.0, 1.0));
+            let walks = inp.walks(&[(k, x)])?;
+            st.surrogate.curves[k].insert(x, &walks);
+        }
+        st.slabs[k] = Slab::new(k, knob, &st.surrogate, inp.obs);
+        let fresh = st.integrate(inp, &[k], None);
+        let moved = (fresh.mode[0] - u).abs();
+        let x = knob.from_unit(fresh.mode[0]);
+        let walks = inp.walks(&[(k, x)])?;
+        st.surrogate.curves[k].insert(x, &walks);
+        let w = &mut st.weighed[i];
+        w.walked_chi2 = Some(chi2_of(inp.obs, &walks));
+        w.walks = Some(walks);
+        w.evidence = fresh;
+        if moved.is_nan() || moved <= 0.25 * widths(&w.evidence)[0] {
+            break;
+        }
+    }
+    st.slabs[k] = Slab::new(k, knob, &st.surrogate, inp.obs);
+    st.weighed[i].evidence = st.integrate(inp, &[k], None);
+    Ok(())
+}
+
+/// Nodes of an anchored curve (the design's value added when inside the range).
+const ANCHORED_NODES: usize = 9;
+
+/// Walks every other suspect's curve (declared parameters and effects) with knob `k` at
+/// `x`: the surrogate's anchored curves, at evenly spaced nodes.
+fn anchor(
+    inp: &Inputs<'_>,
+    st: &mut State,
+    k: usize,
+    x: f64,
+    suspects: &[usize],
+) -> Result<(), GapError> {
+    inp.progress.stage(&format!(
+        "walking the other suspects' curves with {} held at its most probable value",
+        inp.knobs.list[k].label()
+    ));
+    let mut curves = std::collections::BTreeMap::new();
+    let jobs: Vec<(usize, Vec<f64>)> = suspects
+        .iter()
+        .filter(|&&b| b != k)
+        .map(|&b| {
+            let knob = &inp.knobs.list[b];
+            let mut xs = knob.nodes(ANCHORED_NODES);
+            xs.extend(knob.nominal);
+            (b, xs)
+        })
+        .collect();
+    let mut settings = Vec::new();
+    for (b, xs) in &jobs {
+        for xb in xs {
+            settings.push(inp.knobs.setting_at(inp.lib, &[(k, x), (*b, *xb)]));
+        }
+    }
+    let walks = inp
+        .cache
+        .get_many(inp.conditions, inp.lib, &settings, inp.progress)?;
+    let mut it = walks.into_iter();
+    for (b, xs) in jobs {
+        let w: Vec<Vec<Walked>> = (0..xs.len()).filter_map(|_| it.next()).collect();
+        curves.insert(b, super::curve::Curve::new(&st.surrogate.channels, xs, w));
+    }
+    st.surrogate.anchored = Some(Anchored { knob: k, x, curves });
+    Ok(())
+}
+
+/// Confirms pair `i`: walks at its mode and one posterior width along each knob give a
+/// first-order correction; integrate again with it; repeat while the mode moves.
+fn confirm_pair(inp: &Inputs<'_>, st: &mut State, i: usize, rounds: usize) -> Result<(), GapError> {
+    let free = st.weighed[i].hypothesis.knobs.clone();
+    for _ in 0..rounds {
+        let e = &st.weighed[i].evidence;
+        if e.mode.iter().any(|v| !v.is_finite()) {
+            break;
+        }
+        let (u, w) = (e.mode.clone(), widths(e));
+        let set = inp.knobs.set_of(&free, &u);
+        let walks = inp.walks(&set)?;
+        let mut stepped = Vec::new();
+        let mut steps = Vec::new();
+        for j in 0..free.len() {
+            let dir = if u[j] + w[j] <= 1.0 { 1.0 } else { -1.0 };
+            let mut moved = u.clone();
+            moved[j] += dir * w[j];
+            let ms = inp.knobs.set_of(&free, &moved);
+            stepped.push(inp.walks(&ms)?);
+            steps.push(ms[j].1 - set[j].1);
+        }
+        let c = st.surrogate.first_order_at(&set, &walks, &stepped, &steps);
+        let fresh = st.integrate(inp, &free, Some(&c));
+        let moved = fresh
+            .mode
+            .iter()
+            .zip(&u)
+            .zip(&w)
+            .map(|((a, b), w)| (a - b).abs() / w)
+            .fold(0.0, f64::max);
+        let wt = &mut st.weighed[i];
+        wt.walked_chi2 = Some(chi2_of(inp.obs, &walks));
+        wt.walks = Some(walks);
+        wt.evidence = fresh;
+        wt.correction = Some(c);
+        if moved.is_nan() || moved <= 0.25 {
+            break;
+        }
+    }
+    Ok(())
+}
+
+/// Weighs `hypotheses` (the nominal and "something outside these" among them) on
+/// `surrogate`, which the search refines, under the criterion `c`.
+pub fn weigh(
+    inp: &Inputs<'_>,
+    surrogate: Surrogate,
+    slabs: Vec<Slab>,
+    hypotheses: Vec<Hypothesis>,
+    c: &Criterion,
+    search: Search,
+) -> Result<(Posterior, Vec<Slab>), GapError> {
+    let decision = &c.decision;
+    let max_relative = c.none_of_these.max_relative;
+    let mut st = State::new(inp, surrogate, slabs, hypotheses, max_relative);
+    inp.progress.stage(&format!(
+        "integrating {} explanations",
+        st.weighed.len() + 1
+    ));
+    // The nominal's walks are the surrogate's own.
+    for i in 0..st.weighed.len() {
+        if st.weighed[i].hypothesis.knobs.is_empty() {
+            let e = st.integrate(inp, &[], None);
+            let w = &mut st.weighed[i];
+            w.walks = Some(st.surrogate.nominal.clone());
+            w.walked_chi2 = Some(e.chi2_mode);
+            w.evidence = e;
+        }
+    }
+    st.reintegrate(inp, &[]);
+    st.normalise(inp);
+
+    inp.progress
+        .stage("refining the leading single explanations by walks");
+    let singles = st.leading(1, &search, !needs_pairs(&st, decision));
+    st.for_each(&singles, |st, i, key| {
+        refine_single(inp, st, i, search.rounds)?;
+        st.reintegrate(inp, key);
+        Ok(())
+    })?;
+    st.normalise(inp);
+
+    if (search.confirm > 0 && needs_pairs(&st, decision)) || search.exhaustive {
+        anchor_at_best_single(inp, &mut st)?;
+        inp.progress.stage("confirming the leading pairs by walks");
+        let pairs = st.leading(2, &search, false);
+        st.for_each(&pairs, |st, i, _| confirm_pair(inp, st, i, search.rounds))?;
+        st.normalise(inp);
+    }
+    spread_at_leading_modes(inp, &mut st)?;
+    let anchor = st.surrogate.anchored.as_ref().map(|a| (a.knob, a.x));
+    let posterior = Posterior {
+        weighed: st.weighed,
+        outside: st.outside,
+        anchor,
+    };
+    Ok((posterior, st.slabs))
+}
+
+/// Explanations whose likelihood counts the model's own spread at their mode: the three most
+/// probable ones the search walked (the answer is among them).
+const SPREAD_AT_MODE: usize = 3;
+
+/// Counts the model's spread at the mode of the most probable walked explanations, until the
+/// leading ones all count it.
+fn spread_at_leading_modes(inp: &Inputs<'_>, st: &mut State) -> Result<(), GapError> {
+    for _ in 0..3 {
+        let todo: Vec<usize> = (0..st.weighed.len())
+            .filter(|&i| {
+                st.weighed[i].walks.is_some() && !st.weighed[i].hypothesis.knobs.is_empty()
+            })
+            .take(SPREAD_AT_MODE)
+            .filter(|&i| st.weighed[i].obs.is_none())
+            .collect();
+        if todo.is_empty() {
+            break;
+        }
+        for i in todo {
+            st.spread_at_mode(inp, i)?;
+        }
+        st.normalise(inp);
+    }
+    Ok(())
+}
+
+/// Pairs are worth the walks when no explanation yet reaches the threshold, or the most
+/// probable one does not fit.
+fn needs_pairs(st: &State, decision: &Decision) -> bool {
+    let top = st.weighed.first();
+    let outside = st.outside.as_ref().map_or(0.0, |o| o.2);
+    match top {
+        Some(w) => {
+            w.evidence.fit_p < decision.fit_level
+                || w.probability.max(outside) < decision.threshold
+                || outside >= decision.threshold
+        }
+        None => false,
+    }
+}
+
+/// Anchors the surrogate at the most probable refined single explanation's mode, and
+/// integrates every pair holding its knob again.
+fn anchor_at_best_single(inp: &Inputs<'_>, st: &mut State) -> Result<(), GapError> {
+    let Some(best) = st.weighed.iter().find(|w| {
+        w.hypothesis.knobs.len() == 1 && w.walks.is_some() && w.hypothesis.class == Class::One
+    }) else {
+        return Ok(());
+    };
+    let k = best.hypothesis.knobs[0];
+    let x = inp.knobs.list[k].from_unit(best.evidence.mode[0]);
+    let suspects: Vec<usize> = st
+        .weighed
+        .iter()
+        .filter(|w| w.hypothesis.class == Class::One)
+        .map(|w| w.hypothesis.knobs[0])
+        .collect();
+    anchor(inp, st, k, x, &suspects)?;
+    st.reintegrate_where(inp, |h| h.len() == 2 && h.contains(&k));
+    st.normalise(inp);
+    Ok(())
+}
+
+/// Posterior probabilities from priors, evidences and Bayes factors; most probable first (ties
+/// in list order). Every explanation H is weighed alone (prior ∝ its own, evidence Z_H) and
+/// with "something outside these" beside it (prior `outside_prior` spread in proportion to
+/// H's, evidence Z_H·BF_H): P(outside) = q·E / ((1 − q) + q·E), E the posterior mean of BF,
+/// and each explanation keeps its share of the rest.
+fn normalise(weighed: &mut [Weighed], outside_prior: f64) -> f64 {
+    let logs: Vec<f64> = weighed
+        .iter()
+        .map(|w| w.hypothesis.prior.ln() + w.evidence.log_z)
+        .collect();
+    let max = logs.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+    if !max.is_finite() {
+        return 0.0;
+    }
+    let total: f64 = logs.iter().map(|l| (l - max).exp()).sum();
+    let lib: Vec<f64> = logs.iter().map(|l| (l - max).exp() / total).collect();
+    let terms: Vec<f64> = lib
+        .iter()
+        .zip(weighed.iter())
+        .filter(|(p, w)| **p > 0.0 && w.log_bf.is_finite())
+        .map(|(p, w)| p.ln() + w.log_bf)
+        .collect();
+    let top = terms.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+    let log_e = top + terms.iter().map(|t| (t - top).exp()).sum::<f64>().ln();
+    let q = outside_prior;
+    let outside = if q > 0.0 && log_e.is_finite() {
+        1.0 / (1.0 + (((1.0 - q) / q).ln() - log_e).exp())
+    } else {
+        0.0
+    };
+    for (w, p) in weighed.iter_mut().zip(&lib) {
+        w.probability = p * (1.0 - outside);
+    }
+    weighed.sort_by(|a, b| b.probability.total_cmp(&a.probability));
+    outside
+}
