@@ -547,7 +547,12 @@ pub fn calibration(rows: &[&CaseRow]) -> Calibration {
 
 /// The half of the cases the decision is chosen on (the other verifies it).
 pub fn in_choice_half(r: &CaseRow) -> bool {
-    seed_of(&r.key).is_multiple_of(2)
+    // FNV-1a's low bit is only the parity of the key's bytes (a seed's last digit decides it),
+    // so the half is the top bit after splitmix64's finalizer, which mixes every bit.
+    let mut z = seed_of(&r.key);
+    z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
+    z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
+    (z ^ (z >> 31)) >> 63 == 0
 }
 
 /// Thresholds and levels the choice considers.
@@ -558,8 +563,11 @@ const LEVELS: [f64; 8] = [0.05, 0.01, 1e-3, 1e-4, 1e-5, 1e-6, 1e-8, 1e-10];
 
 /// The decision chosen on `rows`: the largest posterior-predictive level at which at most
 /// 1 % of the null cases fail the check, then the smallest threshold at which at most 5 % of
-/// the names given are wrong (not the truth) and at most 1 % of the nulls name anything.
-pub fn choose(rows: &[&CaseRow]) -> Decision {
+/// the names given to cases with a gap are wrong (not the truth) and at most 1 % of the nulls
+/// name anything. Nulls' "no gap" names are judged by the second bound only, so the number
+/// of nulls a benchmark runs does not loosen the first. The flag says whether a threshold of
+/// the grid met both bounds (if none did, the grid's end, 0.99).
+pub fn choose(rows: &[&CaseRow]) -> (Decision, bool) {
     let nulls: Vec<&&CaseRow> = rows.iter().filter(|r| r.kind == "null").collect();
     let level = LEVELS
         .iter()
@@ -570,36 +578,32 @@ pub fn choose(rows: &[&CaseRow]) -> Decision {
         .iter()
         .filter(|r| r.kind != EXPECTED_PAIR && (r.kind != "drake" || r.key.contains("-ref/")))
         .collect();
-    let threshold = THRESHOLDS
-        .iter()
-        .copied()
-        .find(|&t| {
-            let d = Decision {
-                threshold: t,
-                fit_level: level,
-            };
-            let (mut named, mut wrong, mut alarms) = (0, 0, 0);
-            for r in &judged {
-                let o = Outcome::of_row(r, &d);
-                if let Some(n) = &o.named {
-                    named += 1;
-                    let mut n = n.clone();
-                    n.sort();
-                    if truth_knobs(r) != Some(n.clone()) {
-                        wrong += 1;
-                        if r.kind == "null" {
-                            alarms += 1;
-                        }
-                    }
-                }
+    let threshold = THRESHOLDS.iter().copied().find(|&t| {
+        let d = Decision {
+            threshold: t,
+            fit_level: level,
+        };
+        let (mut named, mut wrong, mut alarms) = (0, 0, 0);
+        for r in &judged {
+            let o = Outcome::of_row(r, &d);
+            let Some(n) = &o.named else { continue };
+            let mut n = n.clone();
+            n.sort();
+            let right = truth_knobs(r) == Some(n);
+            if r.kind == "null" {
+                alarms += usize::from(!right);
+            } else {
+                named += 1;
+                wrong += usize::from(!right);
             }
-            wrong as f64 <= 0.05 * named.max(1) as f64 && alarms as f64 <= 0.01 * nulls.len() as f64
-        })
-        .unwrap_or(0.99);
-    Decision {
-        threshold,
+        }
+        wrong as f64 <= 0.05 * named.max(1) as f64 && alarms as f64 <= 0.01 * nulls.len() as f64
+    });
+    let decision = Decision {
+        threshold: threshold.unwrap_or(THRESHOLDS[THRESHOLDS.len() - 1]),
         fit_level: level,
-    }
+    };
+    (decision, threshold.is_some())
 }
 
 /// Scores, calibration and the chosen decision of a benchmark's rows.
@@ -607,9 +611,13 @@ pub fn choose(rows: &[&CaseRow]) -> Decision {
 pub struct BenchmarkSummary {
     pub design: String,
     pub cases: usize,
+    /// Cases per suite and kind (suite, kind, count).
+    pub cases_by_kind: Vec<(String, String, usize)>,
     /// The decision the criterion file holds, and the one chosen on half of these cases.
     pub decision_file: Decision,
     pub decision_chosen: Decision,
+    /// Whether a threshold met the choice's bounds (else `decision_chosen` holds the grid's end).
+    pub threshold_met: bool,
     pub scores: Vec<ScoreLine>,
     pub coverage: ScoreLine,
     /// Calibration on every case, and on the half the decision was not chosen on.
@@ -635,12 +643,14 @@ pub fn summarize(
     let diagnosed: Vec<&CaseRow> = rows.iter().filter(|r| !r.leading.is_empty()).collect();
     let (choice, held): (Vec<&CaseRow>, Vec<&CaseRow>) =
         diagnosed.iter().copied().partition(|r| in_choice_half(r));
-    let chosen = choose(&choice);
+    let (chosen, threshold_met) = choose(&choice);
+    // Without a threshold meeting the bounds, the scores are those of the file's decision.
+    let scored_with = if threshold_met { chosen } else { decision_file };
     let crit: Vec<Scored> = diagnosed
         .iter()
         .map(|r| Scored {
             row: r,
-            outcome: Outcome::of_row(r, &chosen),
+            outcome: Outcome::of_row(r, &scored_with),
         })
         .collect();
     let heldout: Vec<Scored> = crit
@@ -687,8 +697,10 @@ pub fn summarize(
     BenchmarkSummary {
         design: design.to_string(),
         cases: rows.len(),
+        cases_by_kind: cases_by_kind(rows),
         decision_file,
         decision_chosen: chosen,
+        threshold_met,
         scores,
         coverage,
         calibration: calibration(&diagnosed),
@@ -697,6 +709,15 @@ pub fn summarize(
         drake_truth_probability: drake_truth(&diagnosed),
         thresholds,
     }
+}
+
+/// How many cases of each suite and kind `rows` holds.
+fn cases_by_kind(rows: &[CaseRow]) -> Vec<(String, String, usize)> {
+    let mut n: BTreeMap<(String, String), usize> = BTreeMap::new();
+    for r in rows {
+        *n.entry((r.suite.clone(), r.kind.clone())).or_default() += 1;
+    }
+    n.into_iter().map(|((s, k), c)| (s, k, c)).collect()
 }
 
 /// How often the search's most probable explanation differed from the one found with every

@@ -52,22 +52,32 @@ pub fn benchmark_md(b: &BenchmarkSummary, command: &str, rules_files: &[String])
          Rates with their 95 % Clopper–Pearson interval.\n"
     );
     let d = &b.decision_chosen;
+    let threshold = if b.threshold_met {
+        format!("**{}**", d.threshold)
+    } else {
+        "**none of 0.55–0.99 meets both on these cases**".to_string()
+    };
+    let same = b.threshold_met && d == &b.decision_file;
     let _ = writeln!(
         o,
-        "**The decision**, chosen on half of the cases (by the parity of a hash of each case's \
+        "**The decision**, chosen on half of the cases (by a bit of a hash of each case's \
          key): the posterior-predictive level is the largest at which at most 1 % of those null \
-         cases fail the check (**{}**), the threshold the smallest at which at most 5 % of the \
-         names given are wrong and at most 1 % of the nulls name anything (**{}**). \
-         `dataset/gap/criterion.toml` holds threshold {} and level {}{}. The scores below use \
-         the chosen decision; the *held out* column is the half it was not chosen on.\n",
+         cases fail the check (**{}**); the threshold is the smallest at which at most 5 % of \
+         the names given to cases with a gap are wrong and at most 1 % of the nulls name \
+         anything: {threshold}. `dataset/gap/criterion.toml` holds threshold {} and level {}{}. \
+         The scores below use {}; the *held out* column is the half it was not chosen on.\n",
         d.fit_level,
-        d.threshold,
         b.decision_file.threshold,
         b.decision_file.fit_level,
-        if d == &b.decision_file {
+        if same {
             " (the same)"
         } else {
-            " (not the same: update the file)"
+            " (not the chosen decision)"
+        },
+        if b.threshold_met {
+            "the chosen decision"
+        } else {
+            "the file's decision"
         }
     );
     if !rules_files.is_empty() {
@@ -78,6 +88,12 @@ pub fn benchmark_md(b: &BenchmarkSummary, command: &str, rules_files: &[String])
             rules_files.join(", ")
         );
     }
+    let kinds: Vec<String> = b
+        .cases_by_kind
+        .iter()
+        .map(|(s, k, n)| format!("{s} {k} {n}"))
+        .collect();
+    let _ = writeln!(o, "Cases by suite and kind: {}.\n", kinds.join(", "));
     let _ = writeln!(o, "## Scores\n");
     let _ = writeln!(
         o,
@@ -102,6 +118,10 @@ pub fn benchmark_md(b: &BenchmarkSummary, command: &str, rules_files: &[String])
         );
     }
     calibration_md(&mut o, "every case", &b.calibration);
+    let _ = writeln!(
+        o,
+        "\n![Reliability diagram: share right against stated probability](gap-benchmark.svg)"
+    );
     calibration_md(&mut o, "the held-out half", &b.calibration_held_out);
     if !b.drake_truth_probability.is_empty() {
         let _ = writeln!(
