@@ -14,7 +14,7 @@ use super::release::{
     MANIFEST, Release, ReleaseFile, TABLE_CSV, TABLE_PARQUET, compile, parse_semver, sha256_hex,
 };
 use super::validate::{as_release_problems, validate};
-use super::{Dataset, DatasetError};
+use super::{Dataset, DatasetError, Manifest};
 
 /// Today's date (UTC) as YYYY-MM-DD, from the system clock (civil-from-days, H. Hinnant).
 pub fn today_utc() -> String {
@@ -63,63 +63,9 @@ pub fn cut_release(
             "cannot cut a release into the bundled dataset: pass --dataset DIR".into(),
         )
     })?;
-    let parsed = parse_semver(version).ok_or_else(|| {
-        DatasetError::Other(format!("`{version}` is not a semantic version X.Y.Z"))
-    })?;
-    if version != ds.meta.version {
-        return Err(DatasetError::Other(format!(
-            "the live records are version {} (dataset.toml); set it to {version} first",
-            ds.meta.version
-        )));
-    }
-    let mut manifest = ds.manifest()?;
-    if manifest.get(version).is_some() {
-        return Err(DatasetError::Other(format!(
-            "release {version} already exists and is frozen"
-        )));
-    }
-    if let Some(newest) = manifest
-        .releases
-        .iter()
-        .filter_map(|r| parse_semver(&r.version))
-        .max()
-        && parsed <= newest
-    {
-        return Err(DatasetError::Other(format!(
-            "{version} is not newer than the latest release {}.{}.{}",
-            newest.0, newest.1, newest.2
-        )));
-    }
-    let changelog = ds.files.text("CHANGELOG.md").unwrap_or("");
-    if !changelog
-        .lines()
-        .any(|l| l.starts_with("## ") && l.contains(version))
-    {
-        return Err(DatasetError::Other(format!(
-            "CHANGELOG.md has no `## {version}` entry: describe what changed before releasing"
-        )));
-    }
-    // A release treats a speed of unstated kind as an error (a warning in the live records).
-    let problems = as_release_problems(validate(ds).problems);
-    let errors = super::problem::count(&problems, super::Severity::Error);
-    if errors > 0 && !allow_errors {
-        let first = problems
-            .iter()
-            .find(|p| p.severity == super::Severity::Error)
-            .map(|p| format!(", first: {}", p.to_line()))
-            .unwrap_or_default();
-        return Err(DatasetError::Other(format!(
-            "the live records have {errors} error(s) for a release{first}; run `survey validate` and fix them first \
-             (a speed of unstated kind is an error in a release; or --allow-errors to freeze a published table with its known errors)"
-        )));
-    }
-    let note = if errors > 0 {
-        format!("{note} [frozen with {errors} known validation error(s)]")
-            .trim()
-            .to_string()
-    } else {
-        note.to_string()
-    };
+    let mut manifest = check_version(ds, version)?;
+    check_changelog(ds, version)?;
+    let note = release_note(ds, note, allow_errors)?;
     let table = compile(ds);
     let csv = table.to_csv();
     let parquet = table.to_parquet(&ds.vocab)?;
@@ -141,6 +87,96 @@ pub fn cut_release(
     });
     let manifest_text = manifest.to_toml()?;
 
+    write_release(&dir, version, &csv, &parquet, &manifest_text)?;
+    Ok(ReleaseOutcome {
+        version: version.to_string(),
+        rows: table.rows.len(),
+        fitted: table.fitted().count(),
+        files,
+    })
+}
+
+/// Checks that `version` is a semantic version, is the live version, is not yet released
+/// and is newer than every release; returns the current manifest.
+fn check_version(ds: &Dataset, version: &str) -> Result<Manifest, DatasetError> {
+    let parsed = parse_semver(version).ok_or_else(|| {
+        DatasetError::Other(format!("`{version}` is not a semantic version X.Y.Z"))
+    })?;
+    if version != ds.meta.version {
+        return Err(DatasetError::Other(format!(
+            "the live records are version {} (dataset.toml); set it to {version} first",
+            ds.meta.version
+        )));
+    }
+    let manifest = ds.manifest()?;
+    if manifest.get(version).is_some() {
+        return Err(DatasetError::Other(format!(
+            "release {version} already exists and is frozen"
+        )));
+    }
+    if let Some(newest) = manifest
+        .releases
+        .iter()
+        .filter_map(|r| parse_semver(&r.version))
+        .max()
+        && parsed <= newest
+    {
+        return Err(DatasetError::Other(format!(
+            "{version} is not newer than the latest release {}.{}.{}",
+            newest.0, newest.1, newest.2
+        )));
+    }
+    Ok(manifest)
+}
+
+/// Refuses a release whose version has no `## X.Y.Z` heading in CHANGELOG.md.
+fn check_changelog(ds: &Dataset, version: &str) -> Result<(), DatasetError> {
+    let changelog = ds.files.text("CHANGELOG.md").unwrap_or("");
+    if !changelog
+        .lines()
+        .any(|l| l.starts_with("## ") && l.contains(version))
+    {
+        return Err(DatasetError::Other(format!(
+            "CHANGELOG.md has no `## {version}` entry: describe what changed before releasing"
+        )));
+    }
+    Ok(())
+}
+
+/// Validates the live records as a release; returns the manifest note (marked with the
+/// error count when errors are allowed), or refuses when errors are not allowed.
+fn release_note(ds: &Dataset, note: &str, allow_errors: bool) -> Result<String, DatasetError> {
+    // A release treats a speed of unstated kind as an error (a warning in the live records).
+    let problems = as_release_problems(validate(ds).problems);
+    let errors = super::problem::count(&problems, super::Severity::Error);
+    if errors > 0 && !allow_errors {
+        let first = problems
+            .iter()
+            .find(|p| p.severity == super::Severity::Error)
+            .map(|p| format!(", first: {}", p.to_line()))
+            .unwrap_or_default();
+        return Err(DatasetError::Other(format!(
+            "the live records have {errors} error(s) for a release{first}; run `survey validate` and fix them first \
+             (a speed of unstated kind is an error in a release; or --allow-errors to freeze a published table with its known errors)"
+        )));
+    }
+    Ok(if errors > 0 {
+        format!("{note} [frozen with {errors} known validation error(s)]")
+            .trim()
+            .to_string()
+    } else {
+        note.to_string()
+    })
+}
+
+/// Writes the release files and manifest to temporaries under `dir`, then renames them in.
+fn write_release(
+    dir: &Path,
+    version: &str,
+    csv: &[u8],
+    parquet: &[u8],
+    manifest_text: &str,
+) -> Result<(), DatasetError> {
     let releases_dir = dir.join("releases");
     let io = |p: &Path, e| DatasetError::Io {
         path: p.display().to_string(),
@@ -152,7 +188,7 @@ pub fn cut_release(
         std::fs::remove_dir_all(&tmp).map_err(|e| io(&tmp, e))?;
     }
     std::fs::create_dir_all(&tmp).map_err(|e| io(&tmp, e))?;
-    for (name, bytes) in [(TABLE_CSV, &csv), (TABLE_PARQUET, &parquet)] {
+    for (name, bytes) in [(TABLE_CSV, csv), (TABLE_PARQUET, parquet)] {
         let p = tmp.join(name);
         std::fs::write(&p, bytes).map_err(|e| io(&p, e))?;
     }
@@ -164,10 +200,5 @@ pub fn cut_release(
     std::fs::rename(&tmp, &final_dir).map_err(|e| io(&final_dir, e))?;
     let manifest_path = dir.join(MANIFEST);
     std::fs::rename(&manifest_tmp, &manifest_path).map_err(|e| io(&manifest_path, e))?;
-    Ok(ReleaseOutcome {
-        version: version.to_string(),
-        rows: table.rows.len(),
-        fitted: table.fitted().count(),
-        files,
-    })
+    Ok(())
 }

@@ -288,20 +288,7 @@ pub fn parse_record(
     vocab: &Vocabulary,
     problems: &mut Vec<Problem>,
 ) -> Option<Robot> {
-    let table: toml::Table = match text.parse::<toml::Table>() {
-        Ok(t) => t,
-        Err(e) => {
-            problems.push(
-                Problem::error(
-                    file,
-                    Rule::Parse,
-                    format!("not valid TOML: {}", e.message()),
-                )
-                .line(e.span().map(|s| line_of_offset(text, s.start))),
-            );
-            return None;
-        }
-    };
+    let table = parse_table(text, file, problems)?;
     let robot_hint = table.get("id").and_then(|v| v.as_str()).map(str::to_string);
     let p = |rule, field: &str, msg: String| {
         let mut pr = Problem::error(file, rule, msg)
@@ -311,6 +298,55 @@ pub fn parse_record(
         pr
     };
 
+    check_top_keys(&table, &p, problems);
+
+    let id = required_str(&table, "id", &p, problems);
+    let name = required_str(&table, "name", &p, problems);
+    let class_text = required_str(&table, "class", &p, problems);
+    let class = parse_class(class_text.as_deref(), &p, problems);
+    let fit = parse_fit(&table, &p, problems);
+    let exclusion = optional_str(&table, "exclusion", &p, problems);
+    let note = optional_str(&table, "note", &p, problems);
+
+    let sources = parse_sources(&table, file, text, &robot_hint, problems);
+    let values = parse_values(&table, file, text, &robot_hint, vocab, problems);
+
+    Some(Robot {
+        id: id?,
+        name: name?,
+        class: class?,
+        fit: fit?,
+        exclusion,
+        note,
+        sources,
+        values,
+    })
+}
+
+/// Parses the record's TOML, or records a parse problem and returns `None`.
+fn parse_table(text: &str, file: &str, problems: &mut Vec<Problem>) -> Option<toml::Table> {
+    match text.parse::<toml::Table>() {
+        Ok(t) => Some(t),
+        Err(e) => {
+            problems.push(
+                Problem::error(
+                    file,
+                    Rule::Parse,
+                    format!("not valid TOML: {}", e.message()),
+                )
+                .line(e.span().map(|s| line_of_offset(text, s.start))),
+            );
+            None
+        }
+    }
+}
+
+/// Records an unknown-field problem for every top-level key not in `TOP_KEYS`.
+fn check_top_keys(
+    table: &toml::Table,
+    p: &impl Fn(Rule, &str, String) -> Problem,
+    problems: &mut Vec<Problem>,
+) {
     for key in table.keys() {
         if !TOP_KEYS.contains(&key.as_str()) {
             problems.push(p(
@@ -323,36 +359,47 @@ pub fn parse_record(
             ));
         }
     }
+}
 
-    let req_str = |key: &str, problems: &mut Vec<Problem>| -> Option<String> {
-        match table.get(key) {
-            None => {
-                problems.push(p(
-                    Rule::MissingField,
-                    key,
-                    format!("required key `{key}` is missing"),
-                ));
-                None
-            }
-            Some(toml::Value::String(s)) if !s.trim().is_empty() => Some(s.clone()),
-            Some(toml::Value::String(_)) => {
-                problems.push(p(Rule::MissingField, key, format!("`{key}` is empty")));
-                None
-            }
-            Some(other) => {
-                problems.push(p(
-                    Rule::Type,
-                    key,
-                    format!("`{key}` must be a string, found {}", other.type_str()),
-                ));
-                None
-            }
+/// A required non-empty string key; records a problem when missing, empty or not a string.
+fn required_str(
+    table: &toml::Table,
+    key: &str,
+    p: &impl Fn(Rule, &str, String) -> Problem,
+    problems: &mut Vec<Problem>,
+) -> Option<String> {
+    match table.get(key) {
+        None => {
+            problems.push(p(
+                Rule::MissingField,
+                key,
+                format!("required key `{key}` is missing"),
+            ));
+            None
         }
-    };
-    let id = req_str("id", problems);
-    let name = req_str("name", problems);
-    let class_text = req_str("class", problems);
-    let class = class_text.as_deref().and_then(|c| {
+        Some(toml::Value::String(s)) if !s.trim().is_empty() => Some(s.clone()),
+        Some(toml::Value::String(_)) => {
+            problems.push(p(Rule::MissingField, key, format!("`{key}` is empty")));
+            None
+        }
+        Some(other) => {
+            problems.push(p(
+                Rule::Type,
+                key,
+                format!("`{key}` must be a string, found {}", other.type_str()),
+            ));
+            None
+        }
+    }
+}
+
+/// The robot class named by `class_text`; records a problem when it is unknown.
+fn parse_class(
+    class_text: Option<&str>,
+    p: &impl Fn(Rule, &str, String) -> Problem,
+    problems: &mut Vec<Problem>,
+) -> Option<RobotClass> {
+    class_text.and_then(|c| {
         let parsed = RobotClass::parse(c);
         if parsed.is_none() {
             problems.push(p(
@@ -365,8 +412,16 @@ pub fn parse_record(
             ));
         }
         parsed
-    });
-    let fit = match table.get("fit") {
+    })
+}
+
+/// The required boolean `fit`; records a problem when missing or not a boolean.
+fn parse_fit(
+    table: &toml::Table,
+    p: &impl Fn(Rule, &str, String) -> Problem,
+    problems: &mut Vec<Problem>,
+) -> Option<bool> {
+    match table.get("fit") {
         None => {
             problems.push(p(
                 Rule::MissingField,
@@ -384,37 +439,28 @@ pub fn parse_record(
             ));
             None
         }
-    };
-    let opt_str = |key: &str, problems: &mut Vec<Problem>| -> Option<String> {
-        match table.get(key) {
-            None => None,
-            Some(toml::Value::String(s)) => Some(s.clone()),
-            Some(other) => {
-                problems.push(p(
-                    Rule::Type,
-                    key,
-                    format!("`{key}` must be a string, found {}", other.type_str()),
-                ));
-                None
-            }
+    }
+}
+
+/// An optional string key; records a problem when present but not a string.
+fn optional_str(
+    table: &toml::Table,
+    key: &str,
+    p: &impl Fn(Rule, &str, String) -> Problem,
+    problems: &mut Vec<Problem>,
+) -> Option<String> {
+    match table.get(key) {
+        None => None,
+        Some(toml::Value::String(s)) => Some(s.clone()),
+        Some(other) => {
+            problems.push(p(
+                Rule::Type,
+                key,
+                format!("`{key}` must be a string, found {}", other.type_str()),
+            ));
+            None
         }
-    };
-    let exclusion = opt_str("exclusion", problems);
-    let note = opt_str("note", problems);
-
-    let sources = parse_sources(&table, file, text, &robot_hint, problems);
-    let values = parse_values(&table, file, text, &robot_hint, vocab, problems);
-
-    Some(Robot {
-        id: id?,
-        name: name?,
-        class: class?,
-        fit: fit?,
-        exclusion,
-        note,
-        sources,
-        values,
-    })
+    }
 }
 
 fn parse_sources(

@@ -183,6 +183,14 @@ pub fn diff_md(d: &DatasetDiff) -> String {
         moved
     ));
 
+    diff_records_md(&mut out, d);
+    diff_problems_md(&mut out, d);
+    diff_table2_md(&mut out, d, pct);
+    out
+}
+
+/// Writes the added, removed and changed record sections.
+fn diff_records_md(out: &mut String, d: &DatasetDiff) {
     out.push_str(&format!("### Added ({})\n\n", d.added.len()));
     if d.added.is_empty() {
         out.push_str("None.\n");
@@ -216,7 +224,10 @@ pub fn diff_md(d: &DatasetDiff) -> String {
             out.push_str(&change_row(f));
         }
     }
+}
 
+/// Writes the new and resolved validation problem sections.
+fn diff_problems_md(out: &mut String, d: &DatasetDiff) {
     out.push_str(&format!(
         "\n### New validation problems ({})\n\n",
         d.new_problems.len()
@@ -242,7 +253,10 @@ pub fn diff_md(d: &DatasetDiff) -> String {
         }
         out.push_str("```\n");
     }
+}
 
+/// Writes the Table 2 before/after comparison table.
+fn diff_table2_md(out: &mut String, d: &DatasetDiff, pct: f64) {
     out.push_str(&format!(
         "\n### Table 2 ({}, y = A·x^b), release {} → live {}\n\n| relation | class | n | b before [{pct:.0}% CI] | b after | Δb | R² | |\n|---|---|---|---|---|---|---|---|\n",
         d.method.label(),
@@ -289,7 +303,6 @@ pub fn diff_md(d: &DatasetDiff) -> String {
                 .unwrap_or_else(|| "–".into()),
         ));
     }
-    out
 }
 
 fn short(sha: &str) -> &str {

@@ -427,7 +427,22 @@ pub fn exploration_md(e: &Exploration) -> String {
          measurements, {} walks. Plausible: χ² p ≥ {PLAUSIBLE_P} ({} df).\n",
         e.samples, e.seed, e.observations, e.walks, e.observations
     );
-    let verdict = if e.plausible > 0 {
+    let verdict = exploration_verdict(e);
+    let _ = writeln!(o, "{verdict}\n");
+    exploration_metrics_md(&mut o, e);
+    exploration_parameters_md(&mut o, e);
+    if !e.notes.is_empty() {
+        let _ = writeln!(o, "\nNotes:");
+        for n in &e.notes {
+            let _ = writeln!(o, "- {n}");
+        }
+    }
+    o
+}
+
+/// Writes the verdict sentence: how many sampled settings fit the trials.
+fn exploration_verdict(e: &Exploration) -> String {
+    if e.plausible > 0 {
         format!(
             "**{} of {} sampled settings fit the trials within noise** (nominal χ² = {}, best χ² = {}, p = {:.2}).",
             e.plausible,
@@ -462,8 +477,11 @@ pub fn exploration_md(e: &Exploration) -> String {
             sig(e.best_chi2),
             e.best_p
         )
-    };
-    let _ = writeln!(o, "{verdict}\n");
+    }
+}
+
+/// Writes the table of what each measurement can reach.
+fn exploration_metrics_md(o: &mut String, e: &Exploration) {
     let _ = writeln!(o, "## What each measurement can reach\n");
     let _ = writeln!(
         o,
@@ -485,6 +503,10 @@ pub fn exploration_md(e: &Exploration) -> String {
             if m.reachable { "yes" } else { "**no**" }
         );
     }
+}
+
+/// Writes the table of the parameters' plausible values.
+fn exploration_parameters_md(o: &mut String, e: &Exploration) {
     let _ = writeln!(o, "\n## The parameters\n");
     let _ = writeln!(
         o,
@@ -517,13 +539,6 @@ pub fn exploration_md(e: &Exploration) -> String {
             p.why.replace('|', "/")
         );
     }
-    if !e.notes.is_empty() {
-        let _ = writeln!(o, "\nNotes:");
-        for n in &e.notes {
-            let _ = writeln!(o, "- {n}");
-        }
-    }
-    o
 }
 
 /// `survey gap suggest` as Markdown.

@@ -51,35 +51,7 @@ pub fn benchmark_md(b: &BenchmarkSummary, command: &str, rules_files: &[String])
          explanation, and the answer names the most probable one when it reaches the threshold. \
          Rates with their 95 % Clopper–Pearson interval.\n"
     );
-    let d = &b.decision_chosen;
-    let threshold = if b.threshold_met {
-        format!("**{}**", d.threshold)
-    } else {
-        "**none of 0.55–0.99 meets both on these cases**".to_string()
-    };
-    let same = b.threshold_met && d == &b.decision_file;
-    let _ = writeln!(
-        o,
-        "**The decision**, chosen on half of the cases (by a bit of a hash of each case's \
-         key): the posterior-predictive level is the largest at which at most 1 % of those null \
-         cases fail the check (**{}**); the threshold is the smallest at which at most 5 % of \
-         the names given to cases with a gap are wrong and at most 1 % of the nulls name \
-         anything: {threshold}. `dataset/gap/criterion.toml` holds threshold {} and level {}{}. \
-         The scores below use {}; the *held out* column is the half it was not chosen on.\n",
-        d.fit_level,
-        b.decision_file.threshold,
-        b.decision_file.fit_level,
-        if same {
-            " (the same)"
-        } else {
-            " (not the chosen decision)"
-        },
-        if b.threshold_met {
-            "the chosen decision"
-        } else {
-            "the file's decision"
-        }
-    );
+    decision_md(&mut o, b);
     if !rules_files.is_empty() {
         let _ = writeln!(
             o,
@@ -123,6 +95,46 @@ pub fn benchmark_md(b: &BenchmarkSummary, command: &str, rules_files: &[String])
         "\n![Reliability diagram: share right against stated probability](gap-benchmark.svg)"
     );
     calibration_md(&mut o, "the held-out half", &b.calibration_held_out);
+    drake_md(&mut o, b);
+    thresholds_md(&mut o, b);
+    o
+}
+
+/// Writes the paragraph on the decision (threshold and level) the scores use.
+fn decision_md(o: &mut String, b: &BenchmarkSummary) {
+    let d = &b.decision_chosen;
+    let threshold = if b.threshold_met {
+        format!("**{}**", d.threshold)
+    } else {
+        "**none of 0.55–0.99 meets both on these cases**".to_string()
+    };
+    let same = b.threshold_met && d == &b.decision_file;
+    let _ = writeln!(
+        o,
+        "**The decision**, chosen on half of the cases (by a bit of a hash of each case's \
+         key): the posterior-predictive level is the largest at which at most 1 % of those null \
+         cases fail the check (**{}**); the threshold is the smallest at which at most 5 % of \
+         the names given to cases with a gap are wrong and at most 1 % of the nulls name \
+         anything: {threshold}. `dataset/gap/criterion.toml` holds threshold {} and level {}{}. \
+         The scores below use {}; the *held out* column is the half it was not chosen on.\n",
+        d.fit_level,
+        b.decision_file.threshold,
+        b.decision_file.fit_level,
+        if same {
+            " (the same)"
+        } else {
+            " (not the chosen decision)"
+        },
+        if b.threshold_met {
+            "the chosen decision"
+        } else {
+            "the file's decision"
+        }
+    );
+}
+
+/// Writes the table of Drake's added effects' mean posterior.
+fn drake_md(o: &mut String, b: &BenchmarkSummary) {
     if !b.drake_truth_probability.is_empty() {
         let _ = writeln!(
             o,
@@ -134,8 +146,6 @@ pub fn benchmark_md(b: &BenchmarkSummary, command: &str, rules_files: &[String])
             let _ = writeln!(o, "| {f} | {n} | {p:.3} |");
         }
     }
-    thresholds_md(&mut o, b);
-    o
 }
 
 fn calibration_md(o: &mut String, what: &str, c: &Calibration) {

@@ -354,6 +354,32 @@ pub fn prediction_text(p: &crate::analysis::prediction::Prediction) -> String {
         p.dataset.version,
         p.dataset.sha256.get(..12).unwrap_or(&p.dataset.sha256)
     );
+    prediction_leg_text(&mut out, p, pct);
+    prediction_scaled_text(&mut out, p);
+    if let Some(inv) = &p.inverse {
+        out.push_str(&format!(
+            "mass budget {} kg → leg length {} m{} (median mass on the {} fit m = {:.4}·L^{:.3})\n",
+            inv.mass_budget_kg,
+            sig(inv.leg_length_m),
+            inv.leg_length_ci
+                .map(|c| format!(", {pct:.0}% CI [{}, {}]", sig(c[0]), sig(c[1])))
+                .unwrap_or_else(|| ", CI unbounded (slope not significant)".into()),
+            inv.law.class.as_str(),
+            inv.law.a,
+            inv.law.b
+        ));
+        if let Some(w) = &inv.extrapolation {
+            out.push_str(&format!("warning: {w}\n"));
+        }
+    }
+    if let Some(w) = &p.extrapolation {
+        out.push_str(&format!("warning: {w}\n"));
+    }
+    out
+}
+
+/// Writes the per-quantity table (and Froude number) for the target leg length.
+fn prediction_leg_text(out: &mut String, p: &crate::analysis::prediction::Prediction, pct: f64) {
     if let Some(l) = p.leg_length_m {
         out.push_str(&format!("target leg length L = {l} m\n"));
         out.push_str(&format!(
@@ -404,6 +430,10 @@ pub fn prediction_text(p: &crate::analysis::prediction::Prediction) -> String {
             out.push_str(&format!("  no {} speed predicted: {why}\n", p.speed_kind));
         }
     }
+}
+
+/// Writes the masses of the reference robot scaled to the target leg length.
+fn prediction_scaled_text(out: &mut String, p: &crate::analysis::prediction::Prediction) {
     if let Some(s) = &p.scaled_reference {
         let fit_mass = p
             .quantities
@@ -439,26 +469,6 @@ pub fn prediction_text(p: &crate::analysis::prediction::Prediction) -> String {
             ));
         }
     }
-    if let Some(inv) = &p.inverse {
-        out.push_str(&format!(
-            "mass budget {} kg → leg length {} m{} (median mass on the {} fit m = {:.4}·L^{:.3})\n",
-            inv.mass_budget_kg,
-            sig(inv.leg_length_m),
-            inv.leg_length_ci
-                .map(|c| format!(", {pct:.0}% CI [{}, {}]", sig(c[0]), sig(c[1])))
-                .unwrap_or_else(|| ", CI unbounded (slope not significant)".into()),
-            inv.law.class.as_str(),
-            inv.law.a,
-            inv.law.b
-        ));
-        if let Some(w) = &inv.extrapolation {
-            out.push_str(&format!("warning: {w}\n"));
-        }
-    }
-    if let Some(w) = &p.extrapolation {
-        out.push_str(&format!("warning: {w}\n"));
-    }
-    out
 }
 
 /// `survey test slope` as text: the fit, then one line per hypothesis.

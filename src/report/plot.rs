@@ -160,79 +160,9 @@ fn draw_panel<DB: DrawingBackend>(
         .draw()
         .map_err(|e| e.to_string())?;
     for s in &panel.series {
-        let color = s.color;
-        if !s.band.is_empty() {
-            let mut poly: Vec<(f64, f64)> = s.band.iter().map(|b| (b.0, b.2)).collect();
-            poly.extend(s.band.iter().rev().map(|b| (b.0, b.1)));
-            chart
-                .draw_series(std::iter::once(Polygon::new(
-                    poly,
-                    color.mix(0.15).filled(),
-                )))
-                .map_err(|e| e.to_string())?;
-        }
-        if !s.points.is_empty() {
-            // Each marker is its own element type, in data and in legend coordinates: the
-            // macro writes the element once for both.
-            macro_rules! marked {
-                (|$p:ident, $r:ident| $e:expr) => {{
-                    let anno = chart
-                        .draw_series(s.points.iter().map(|&$p| {
-                            let $r: i32 = 4;
-                            $e
-                        }))
-                        .map_err(|e| e.to_string())?;
-                    if !s.unlabelled {
-                        anno.label(&s.label).legend(move |(x, y)| {
-                            let ($p, $r): ((i32, i32), i32) = ((x + 8, y), 4);
-                            $e
-                        });
-                    }
-                }};
-            }
-            match s.marker {
-                Marker::Circle => marked!(|p, r| Circle::new(p, r, color.filled())),
-                Marker::Square => {
-                    marked!(|p, r| EmptyElement::at(p)
-                        + Rectangle::new([(-r, -r), (r, r)], color.filled()))
-                }
-                Marker::Triangle => marked!(|p, r| TriangleMarker::new(p, r + 1, color.filled())),
-                Marker::Cross => marked!(|p, r| Cross::new(p, r, color.stroke_width(2))),
-            }
-        }
-        if let Some((a, b)) = s.line {
-            let (lo, hi) = s.line_range.unwrap_or_else(|| {
-                s.points
-                    .iter()
-                    .map(|p| p.0)
-                    .chain(s.band.iter().map(|p| p.0))
-                    .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), v| {
-                        (l.min(v), h.max(v))
-                    })
-            });
-            if lo.is_finite() && hi > lo {
-                let steps = 50;
-                let line = (0..=steps).map(|i| {
-                    let x = lo * (hi / lo).powf(i as f64 / steps as f64);
-                    (x, a * x.powf(b))
-                });
-                let line: Vec<(f64, f64)> = line.collect();
-                let drawn = if s.dashed {
-                    chart
-                        .draw_series(DashedLineSeries::new(line, 8, 5, color.stroke_width(2)))
-                        .map_err(|e| e.to_string())?
-                } else {
-                    chart
-                        .draw_series(LineSeries::new(line, color.stroke_width(2)))
-                        .map_err(|e| e.to_string())?
-                };
-                if s.points.is_empty() && !s.unlabelled {
-                    drawn.label(&s.label).legend(move |(x, y)| {
-                        PathElement::new(vec![(x, y), (x + 16, y)], color.stroke_width(2))
-                    });
-                }
-            }
-        }
+        draw_band(&mut chart, s)?;
+        draw_markers(&mut chart, s)?;
+        draw_line(&mut chart, s)?;
     }
     chart
         .configure_series_labels()
@@ -242,6 +172,106 @@ fn draw_panel<DB: DrawingBackend>(
         .position(panel.legend.clone())
         .draw()
         .map_err(|e| e.to_string())?;
+    Ok(())
+}
+
+/// Draws a series' shaded band.
+fn draw_band<'a, DB: DrawingBackend + 'a, CT: CoordTranslate<From = (f64, f64)>>(
+    chart: &mut ChartContext<'a, DB, CT>,
+    s: &Series,
+) -> Result<(), String> {
+    let color = s.color;
+    if !s.band.is_empty() {
+        let mut poly: Vec<(f64, f64)> = s.band.iter().map(|b| (b.0, b.2)).collect();
+        poly.extend(s.band.iter().rev().map(|b| (b.0, b.1)));
+        chart
+            .draw_series(std::iter::once(Polygon::new(
+                poly,
+                color.mix(0.15).filled(),
+            )))
+            .map_err(|e| e.to_string())?;
+    }
+    Ok(())
+}
+
+/// Draws a series' markers, with their legend entry.
+fn draw_markers<'a, DB: DrawingBackend + 'a, CT: CoordTranslate<From = (f64, f64)>>(
+    chart: &mut ChartContext<'a, DB, CT>,
+    s: &Series,
+) -> Result<(), String> {
+    let color = s.color;
+    if !s.points.is_empty() {
+        // Each marker is its own element type, in data and in legend coordinates: the
+        // macro writes the element once for both.
+        macro_rules! marked {
+            (|$p:ident, $r:ident| $e:expr) => {{
+                let anno = chart
+                    .draw_series(s.points.iter().map(|&$p| {
+                        let $r: i32 = 4;
+                        $e
+                    }))
+                    .map_err(|e| e.to_string())?;
+                if !s.unlabelled {
+                    anno.label(&s.label).legend(move |(x, y)| {
+                        let ($p, $r): ((i32, i32), i32) = ((x + 8, y), 4);
+                        $e
+                    });
+                }
+            }};
+        }
+        match s.marker {
+            Marker::Circle => marked!(|p, r| Circle::new(p, r, color.filled())),
+            Marker::Square => {
+                marked!(
+                    |p, r| EmptyElement::at(p) + Rectangle::new([(-r, -r), (r, r)], color.filled())
+                )
+            }
+            Marker::Triangle => marked!(|p, r| TriangleMarker::new(p, r + 1, color.filled())),
+            Marker::Cross => marked!(|p, r| Cross::new(p, r, color.stroke_width(2))),
+        }
+    }
+    Ok(())
+}
+
+/// Draws a series' fitted line, with its legend entry when it has no markers.
+fn draw_line<'a, DB: DrawingBackend + 'a, CT: CoordTranslate<From = (f64, f64)>>(
+    chart: &mut ChartContext<'a, DB, CT>,
+    s: &Series,
+) -> Result<(), String> {
+    let color = s.color;
+    if let Some((a, b)) = s.line {
+        let (lo, hi) = s.line_range.unwrap_or_else(|| {
+            s.points
+                .iter()
+                .map(|p| p.0)
+                .chain(s.band.iter().map(|p| p.0))
+                .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), v| {
+                    (l.min(v), h.max(v))
+                })
+        });
+        if lo.is_finite() && hi > lo {
+            let steps = 50;
+            let line = (0..=steps).map(|i| {
+                let x = lo * (hi / lo).powf(i as f64 / steps as f64);
+                (x, a * x.powf(b))
+            });
+            let line: Vec<(f64, f64)> = line.collect();
+            let drawn = if s.dashed {
+                chart
+                    .draw_series(DashedLineSeries::new(line, 8, 5, color.stroke_width(2)))
+                    .map_err(|e| e.to_string())?
+            } else {
+                chart
+                    .draw_series(LineSeries::new(line, color.stroke_width(2)))
+                    .map_err(|e| e.to_string())?
+            };
+            if s.points.is_empty() && !s.unlabelled {
+                drawn.label(&s.label).legend(move |(x, y)| {
+                    PathElement::new(vec![(x, y), (x + 16, y)], color.stroke_width(2))
+                });
+            }
+        }
+    }
     Ok(())
 }
 

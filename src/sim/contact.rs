@@ -500,7 +500,6 @@ fn disc_segment(
         det_t,
         u_max,
         r0,
-        r02,
         one_m,
         rho,
         rho2,
@@ -508,13 +507,65 @@ fn disc_segment(
         modulus_pa,
         sigma_min,
         s0,
+        ..
+    } = *f;
+    let cos_d = (d / u_max).clamp(-1.0, 1.0);
+    let (f0, f1, e_sum, k) = segment_quadrature(p, f, m, cos_d, center, rot, with_energy);
+    if f0 <= 0.0 {
+        return false;
+    }
+    let shift = f1 / f0;
+    let scale = modulus_pa * det_t;
+    p.elastic_force_n = scale * f0;
+    p.cop = Vector3::new(s0.x + shift.x, s0.y + shift.y, 0.0);
+    p.energy_j = modulus_pa * det_t * e_sum;
+    let (mut sxx, mut sxy, mut syy) = (0.0, 0.0, 0.0);
+    for (off, &wgt) in p.quad_offsets[..k].iter_mut().zip(&p.quad_weights[..k]) {
+        *off -= shift;
+        sxx += off.x * off.x * wgt;
+        sxy += off.x * off.y * wgt;
+        syy += off.y * off.y * wgt;
+    }
+    let s2 = Matrix2::new(sxx, sxy, sxy, syy);
+    p.second_moment = s2 * scale;
+    p.quad_len = k;
+    normalise(&mut p.quad_weights[..k], f0);
+    // Slope for the implicit step: the full patch's, scaled by the clipped share.
+    let f_full = FRAC_PI_3 * modulus_pa * abc / rho * one_m * one_m * (1.0 + 2.0 * r0);
+    let k_full = 2.0 * PI * modulus_pa * abc * r0 * one_m / rho2;
+    p.stiffness_n_per_m = k_full * (p.elastic_force_n / f_full.max(1e-300)).min(1.0);
+    // Distance from the centre of pressure to the cut line bounds the inner disc.
+    let to_cut = (m.dot(&(t.try_inverse().unwrap_or_else(Matrix2::identity) * shift)) - d).max(0.0);
+    p.inner_radius_m = (to_cut * sigma_min).min(u_max * sigma_min);
+    true
+}
+
+/// Fills `p`'s quadrature nodes with the 8 × 4 Gauss rule over the disc segment
+/// m·u ≥ d (`cos_d` = d/u_max); returns (Σw, Σw·offset, energy integrand sum, node count).
+#[inline]
+fn segment_quadrature(
+    p: &mut Patch,
+    f: &PatchFrame,
+    m: Vector2<f64>,
+    cos_d: f64,
+    center: &Vector3<f64>,
+    rot: &Matrix3<f64>,
+    with_energy: bool,
+) -> (f64, Vector2<f64>, f64, usize) {
+    let PatchFrame {
+        t,
+        det_t,
+        u_max,
+        r02,
+        modulus_pa,
+        s0,
         inv_a2,
+        ..
     } = *f;
     // Disc segment m·u ≥ d in polar-like coordinates about m: u = U cosφ m +
     // U sinφ σ m⊥, φ ∈ [0, acos(d/U)], σ ∈ [−1, 1]; dA_u = U² sin²φ dφ dσ. The
     // integrand is smooth in (φ, σ), so an 8 × 4 Gauss rule is accurate to ~1e-6.
     let mp = Vector2::new(-m.y, m.x);
-    let cos_d = (d / u_max).clamp(-1.0, 1.0);
     let phi_d = cos_d.acos();
     // Angular nodes φ = h(1 ± ξⱼ), h = φ_d/2 (the Gauss nodes are symmetric): sin/cos
     // by the addition theorem from h (half-angle formulas) and the four hξⱼ.
@@ -561,33 +612,7 @@ fn disc_segment(
             k += 1;
         }
     }
-    if f0 <= 0.0 {
-        return false;
-    }
-    let shift = f1 / f0;
-    let scale = modulus_pa * det_t;
-    p.elastic_force_n = scale * f0;
-    p.cop = Vector3::new(s0.x + shift.x, s0.y + shift.y, 0.0);
-    p.energy_j = modulus_pa * det_t * e_sum;
-    let (mut sxx, mut sxy, mut syy) = (0.0, 0.0, 0.0);
-    for (off, &wgt) in p.quad_offsets[..k].iter_mut().zip(&p.quad_weights[..k]) {
-        *off -= shift;
-        sxx += off.x * off.x * wgt;
-        sxy += off.x * off.y * wgt;
-        syy += off.y * off.y * wgt;
-    }
-    let s2 = Matrix2::new(sxx, sxy, sxy, syy);
-    p.second_moment = s2 * scale;
-    p.quad_len = k;
-    normalise(&mut p.quad_weights[..k], f0);
-    // Slope for the implicit step: the full patch's, scaled by the clipped share.
-    let f_full = FRAC_PI_3 * modulus_pa * abc / rho * one_m * one_m * (1.0 + 2.0 * r0);
-    let k_full = 2.0 * PI * modulus_pa * abc * r0 * one_m / rho2;
-    p.stiffness_n_per_m = k_full * (p.elastic_force_n / f_full.max(1e-300)).min(1.0);
-    // Distance from the centre of pressure to the cut line bounds the inner disc.
-    let to_cut = (m.dot(&(t.try_inverse().unwrap_or_else(Matrix2::identity) * shift)) - d).max(0.0);
-    p.inner_radius_m = (to_cut * sigma_min).min(u_max * sigma_min);
-    true
+    (f0, f1, e_sum, k)
 }
 
 fn normalise(w: &mut [f64], sum: f64) {

@@ -599,7 +599,86 @@ fn analyze(
     let cycles = ((t_end - start) / period).floor().max(0.0) as usize;
     let stop = start + cycles as f64 * period;
     let nan = f64::NAN;
-    let mut r = WalkReport {
+    let mut r = unmeasured_report(d, facts, opts, &fall, converged_at_s, start, cycles);
+    if fall.is_some() || cycles < 2 {
+        return r;
+    }
+    let i0 = samples.partition_point(|s| s.t_s < start);
+    let i1 = samples.partition_point(|s| s.t_s <= stop + 1e-9);
+    let win = &samples[i0..i1];
+    if win.len() < 3 {
+        return r;
+    }
+    // Per-cycle peak-to-valley attitude. Yaw is first detrended over the cycle (minus the
+    // straight line between its values at the cycle's ends) so a slowly turning walker
+    // reports its yaw oscillation, not its heading change.
+    let pp = attitude_pp(samples, start, period, cycles);
+    (r.roll_pp_deg, r.roll_pp_deg_sd) = mean_sd(&pp[0]);
+    (r.pitch_pp_deg, r.pitch_pp_deg_sd) = mean_sd(&pp[1]);
+    (r.yaw_pp_deg, r.yaw_pp_deg_sd) = mean_sd(&pp[2]);
+    // Speed along the mean heading (circular mean of yaw).
+    let (sx, sy) = win.iter().fold((0.0, 0.0), |(a, b), s| {
+        (
+            a + s.yaw_deg.to_radians().cos(),
+            b + s.yaw_deg.to_radians().sin(),
+        )
+    });
+    let heading = sy.atan2(sx);
+    let (a, b) = (win[0], win[win.len() - 1]);
+    let dt = b.t_s - a.t_s;
+    let (dx, dy) = (b.x_m - a.x_m, b.y_m - a.y_m);
+    let forward = dx * heading.cos() + dy * heading.sin();
+    r.velocity_mps = forward / dt;
+    r.froude = r.velocity_mps / (GRAVITY_MPS2 * l).sqrt();
+    let distance = (dx * dx + dy * dy).sqrt();
+    r.turning_deg_per_m = if distance > 0.0 {
+        (b.yaw_deg - a.yaw_deg) / distance
+    } else {
+        nan
+    };
+    // Steps: transfers of support. A step is taken when the other foot carries more than
+    // three quarters of the normal load (weight acceptance); the hysteresis keeps contact
+    // chatter and double support from counting, and samples in flight (< 20 % of m·g on the
+    // ground) keep the current stance. This is the definition of a step itself; roll-side
+    // crossings (used before) agree on the bundled gaits but are only a proxy for it.
+    let crossings = count_steps(win, m);
+    r.step_frequency_hz = crossings as f64 / dt;
+    r.mechanical_work_j = b.positive_work_j - a.positive_work_j;
+    r.cot = if distance > 0.0 {
+        r.mechanical_work_j / (m * GRAVITY_MPS2 * distance)
+    } else {
+        nan
+    };
+    r.peak_torque_nm = win[1..]
+        .iter()
+        .map(|s| s.peak_abs_torque_nm)
+        .fold(0.0, f64::max);
+    // A design that walks either way (fore–aft symmetric, flat) walks backward as well as
+    // forward.
+    let speed = if d.walks_either_way() {
+        r.velocity_mps.abs()
+    } else {
+        r.velocity_mps
+    };
+    r.walks = speed > d.criteria.walk_speed_threshold_mps(l);
+    r
+}
+
+/// The report with the run's facts filled in and every gait metric NaN (not yet measured).
+fn unmeasured_report(
+    d: &Design,
+    facts: &RunFacts,
+    opts: &WalkOptions,
+    fall: &Option<(String, f64)>,
+    converged_at_s: Option<f64>,
+    start: f64,
+    cycles: usize,
+) -> WalkReport {
+    let l = d.geometry.leg_length_m;
+    let m = d.mass.total_mass_kg;
+    let freq = facts.drive_frequency_hz;
+    let nan = f64::NAN;
+    WalkReport {
         design: d.name.clone(),
         leg_length_m: l,
         mass_kg: m,
@@ -629,19 +708,16 @@ fn analyze(
         mechanical_work_j: nan,
         cot: nan,
         peak_torque_nm: nan,
-    };
-    if fall.is_some() || cycles < 2 {
-        return r;
     }
-    let i0 = samples.partition_point(|s| s.t_s < start);
-    let i1 = samples.partition_point(|s| s.t_s <= stop + 1e-9);
-    let win = &samples[i0..i1];
-    if win.len() < 3 {
-        return r;
-    }
-    // Per-cycle peak-to-valley attitude. Yaw is first detrended over the cycle (minus the
-    // straight line between its values at the cycle's ends) so a slowly turning walker
-    // reports its yaw oscillation, not its heading change.
+}
+
+/// Per-cycle peak-to-valley roll, pitch and detrended yaw over the metrics window.
+fn attitude_pp(
+    samples: &[TrajectorySample],
+    start: f64,
+    period: f64,
+    cycles: usize,
+) -> [Vec<f64>; 3] {
     let mut pp = [Vec::new(), Vec::new(), Vec::new()];
     for c in 0..cycles {
         let t0 = start + c as f64 * period;
@@ -659,34 +735,11 @@ fn analyze(
         });
         pp[2].push(hi - lo);
     }
-    (r.roll_pp_deg, r.roll_pp_deg_sd) = mean_sd(&pp[0]);
-    (r.pitch_pp_deg, r.pitch_pp_deg_sd) = mean_sd(&pp[1]);
-    (r.yaw_pp_deg, r.yaw_pp_deg_sd) = mean_sd(&pp[2]);
-    // Speed along the mean heading (circular mean of yaw).
-    let (sx, sy) = win.iter().fold((0.0, 0.0), |(a, b), s| {
-        (
-            a + s.yaw_deg.to_radians().cos(),
-            b + s.yaw_deg.to_radians().sin(),
-        )
-    });
-    let heading = sy.atan2(sx);
-    let (a, b) = (win[0], win[win.len() - 1]);
-    let dt = b.t_s - a.t_s;
-    let (dx, dy) = (b.x_m - a.x_m, b.y_m - a.y_m);
-    let forward = dx * heading.cos() + dy * heading.sin();
-    r.velocity_mps = forward / dt;
-    r.froude = r.velocity_mps / (GRAVITY_MPS2 * l).sqrt();
-    let distance = (dx * dx + dy * dy).sqrt();
-    r.turning_deg_per_m = if distance > 0.0 {
-        (b.yaw_deg - a.yaw_deg) / distance
-    } else {
-        nan
-    };
-    // Steps: transfers of support. A step is taken when the other foot carries more than
-    // three quarters of the normal load (weight acceptance); the hysteresis keeps contact
-    // chatter and double support from counting, and samples in flight (< 20 % of m·g on the
-    // ground) keep the current stance. This is the definition of a step itself; roll-side
-    // crossings (used before) agree on the bundled gaits but are only a proxy for it.
+    pp
+}
+
+/// Number of support transfers (steps) in the window `win` for a walker of mass `m`.
+fn count_steps(win: &[TrajectorySample], m: f64) -> usize {
     let mut stance: Option<usize> = None;
     let mut crossings = 0usize;
     for s in win {
@@ -702,26 +755,7 @@ fn analyze(
             stance = Some(k);
         }
     }
-    r.step_frequency_hz = crossings as f64 / dt;
-    r.mechanical_work_j = b.positive_work_j - a.positive_work_j;
-    r.cot = if distance > 0.0 {
-        r.mechanical_work_j / (m * GRAVITY_MPS2 * distance)
-    } else {
-        nan
-    };
-    r.peak_torque_nm = win[1..]
-        .iter()
-        .map(|s| s.peak_abs_torque_nm)
-        .fold(0.0, f64::max);
-    // A design that walks either way (fore–aft symmetric, flat) walks backward as well as
-    // forward.
-    let speed = if d.walks_either_way() {
-        r.velocity_mps.abs()
-    } else {
-        r.velocity_mps
-    };
-    r.walks = speed > d.criteria.walk_speed_threshold_mps(l);
-    r
+    crossings
 }
 
 /// Writes the trajectory as CSV.

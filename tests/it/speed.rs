@@ -196,21 +196,26 @@ fn speed_slope_tests_match_smatr_for_ols_sma_and_ma() {
         ("ma", 0.25, 0.948062716751543, 0.0519372832484566),
         ("ma", 0.0, 0.984374038697697, 0.0156259613023028),
     ];
-    for method in ["ols", "sma", "ma"] {
-        let v = json(&[
+    let dataset = d(data.path());
+    // `survey test slope` of the quadrupeds' speeds, as JSON, with `extra` flags.
+    let slope = |extra: &[&str]| {
+        let mut args = vec![
             "test",
             "slope",
             "--dataset",
-            &d(data.path()),
+            &dataset,
             "--class",
             "quadruped",
             "--y",
             "speed",
-            "--method",
-            method,
             "--format",
             "json",
-        ]);
+        ];
+        args.extend_from_slice(extra);
+        json(&args)
+    };
+    for method in ["ols", "sma", "ma"] {
+        let v = slope(&["--method", method]);
         assert_eq!(v["y"], "speed_top");
         // The laws' exponents by default: 0.5 (dynamic similarity), 0.25 (biology), 0.
         let b0s: Vec<f64> = v["tests"]
@@ -237,20 +242,7 @@ fn speed_slope_tests_match_smatr_for_ols_sma_and_ma() {
         }
     }
     // An explicit exponent replaces the laws'.
-    let v = json(&[
-        "test",
-        "slope",
-        "--dataset",
-        &d(data.path()),
-        "--class",
-        "quadruped",
-        "--y",
-        "speed",
-        "--value",
-        "0.25",
-        "--format",
-        "json",
-    ]);
+    let v = slope(&["--value", "0.25"]);
     assert_eq!(v["tests"].as_array().unwrap().len(), 1);
 }
 
