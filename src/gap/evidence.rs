@@ -284,28 +284,41 @@ fn one_knob(target: &Target<'_>) -> Evidence {
     else {
         return Evidence::empty(1);
     };
-    let (mode, lmax) = polish(target, &[best.0], h);
-    let mode = mode[0];
-    let sigma = curvature_sd(target, mode).unwrap_or(h);
+    let (polished, lpol) = polish(target, &[best.0], h);
+    let sigma = curvature_sd(target, polished[0]).unwrap_or(h);
     let reach = 8.0 * sigma;
     let sub = ((8.0 * h / sigma).ceil() as usize).clamp(1, 4096);
-    let mut points = Vec::new();
+    // (u, ln density, χ², cell width) at every point of the rule.
+    let mut raw: Vec<(f64, f64, f64, f64)> = Vec::new();
     for (i, &(u, l, c)) in coarse.iter().enumerate() {
         let (a, b) = (i as f64 * h, (i + 1) as f64 * h);
-        if sub > 1 && b > mode - reach && a < mode + reach {
+        if sub > 1 && b > polished[0] - reach && a < polished[0] + reach {
             let w = h / sub as f64;
             for j in 0..sub {
                 let v = a + (j as f64 + 0.5) * w;
                 let (lv, cv) = target.eval(&[v]);
-                if lv.is_finite() {
-                    points.push((vec![v], (lv - lmax).exp() * w, cv));
-                }
+                raw.push((v, lv, cv, w));
             }
-        } else if l.is_finite() {
-            points.push((vec![u], (l - lmax).exp() * h, c));
+        } else {
+            raw.push((u, l, c, h));
         }
     }
-    let w = Weighted { points };
+    raw.retain(|p| p.1.is_finite());
+    // The mode is the best point evaluated (on a knife-edge likelihood a point of the rule
+    // can beat the polished one); weights relative to it never overflow.
+    let (mode, lmax) = raw
+        .iter()
+        .map(|p| (p.0, p.1))
+        .chain(std::iter::once((polished[0], lpol)))
+        .filter(|p| p.1.is_finite())
+        .max_by(|a, b| a.1.total_cmp(&b.1))
+        .unwrap_or((polished[0], lpol));
+    let w = Weighted {
+        points: raw
+            .into_iter()
+            .map(|(u, l, c, width)| (vec![u], (l - lmax).exp() * width, c))
+            .collect(),
+    };
     let log_z_laplace = curvature_sd(target, mode)
         .map(|s| lmax + 0.5 * (2.0 * std::f64::consts::PI).ln() + s.ln())
         .unwrap_or(f64::NAN);

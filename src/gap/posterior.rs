@@ -1,23 +1,12 @@
 //! The posterior over explanations, and the search that makes it trustworthy.
 //!
 //! The criterion is fixed: P(H | trials) ∝ P(H) · Z_H ([`super::hypothesis`],
-//! [`super::evidence`]). The search only decides how well each Z_H is computed, by refining
-//! the surrogate with real walks where the leading explanations' posteriors lie:
-//!
-//! 1. every explanation is integrated on the additive surrogate;
-//! 2. the leading single explanations are *refined*: walks at the mode and one posterior
-//!    width either side become nodes of the knob's curve, until the mode stops moving (a
-//!    knife-edge gait needs several rounds);
-//! 3. when the best explanation so far does not reach the threshold or fails the
-//!    posterior-predictive check, every other suspect's curve is walked again with the best
-//!    single's knob held at its mode ([`super::surrogate::Anchored`]): pairs holding it then
-//!    see how the two interact;
-//! 4. the leading pairs are *confirmed*: walks at the mode and one step along each knob give
-//!    a first-order correction, until the mode stops moving.
-//!
-//! What the search can miss is an explanation ranked too low to be refined or confirmed;
-//! [`Search::exhaustive`] refines and confirms every one, which is how the misses are
-//! measured (reports/gap-benchmark.md).
+//! [`super::evidence`]). The search only decides how well each Z_H is computed: it integrates
+//! every explanation on the additive surrogate, refines the leading singles and confirms the
+//! leading pairs by real walks (the pairs about the best single, [`super::surrogate::Anchored`]),
+//! repeats while the top of either size is unwalked, and walks the overall top last, so that
+//! the answer rests on walks (the steps and why: docs/gap-criterion.md, "The search").
+//! [`Search::exhaustive`] refines and confirms every explanation: how misses are measured.
 
 use rayon::prelude::*;
 
@@ -84,6 +73,9 @@ pub struct Weighed {
     /// over it alone, at its most probable point.
     pub log_bf: f64,
     pub probability: f64,
+    /// Its probability given that one of the library's explanations holds: what the search
+    /// ranks by (`probability` underflows to 0 when "something outside these" takes all).
+    pub share: f64,
 }
 
 /// The posterior: every explanation weighed, most probable first, and "something outside
@@ -126,8 +118,8 @@ struct State {
 
 impl State {
     /// Every explanation's Bayes factor with "something outside these" beside it, at its
-    /// most probable point: walked predictions where the search walked it (and its
-    /// observations with the model's spread there), else the surrogate's.
+    /// most probable point (with its observations with the model's spread there, where
+    /// counted).
     fn bayes_factors(&mut self, inp: &Inputs<'_>) {
         let Some(d) = &self.discrepancy else { return };
         let bfs: Vec<f64> = self
@@ -144,13 +136,14 @@ impl State {
         }
     }
 
-    /// An explanation's predictions of every observation at its most probable point.
+    /// An explanation's predictions at its most probable point on the surrogate (and walks'
+    /// correction) its evidence integrates, so that its Bayes factor compares like with like.
     fn predictions(&self, inp: &Inputs<'_>, w: &Weighed) -> Vec<f64> {
-        if let Some(walks) = &w.walks {
+        if w.hypothesis.knobs.is_empty() {
             return inp
                 .obs
                 .iter()
-                .map(|o| walks[o.trial].channel(o.channel))
+                .map(|o| self.surrogate.nominal[o.trial].channel(o.channel))
                 .collect();
         }
         if w.evidence.mode.iter().any(|v| !v.is_finite()) {
@@ -201,6 +194,7 @@ impl State {
                 obs: None,
                 log_bf: f64::NEG_INFINITY,
                 probability: 0.0,
+                share: 0.0,
             })
             .collect();
         State {
@@ -335,22 +329,21 @@ impl State {
         Ok(())
     }
 
-    /// Indices of the most probable explanations of `len` knobs not yet walked whose
-    /// probability is at least `share` of the most probable explanation of that size — and,
-    /// when an explanation already stands (`settled`: it reaches the threshold and fits), of
-    /// that one's — at most `search.confirm`; all with `exhaustive`.
-    fn leading(&self, len: usize, search: &Search, settled: bool) -> Vec<usize> {
+    /// The most probable unwalked explanations of `len` knobs, at most `search.confirm`, with
+    /// at least `share` of the top one's probability (of that size, or overall when `settled`)
+    /// — no such floor when `wide` (nothing walked fits) or `exhaustive` (all of them).
+    fn leading(&self, len: usize, search: &Search, settled: bool, wide: bool) -> Vec<usize> {
         let of_len: Vec<usize> = (0..self.weighed.len())
             .filter(|&i| self.weighed[i].hypothesis.knobs.len() == len)
             .collect();
-        let mut top = of_len.first().map_or(0.0, |&i| self.weighed[i].probability);
+        let mut top = of_len.first().map_or(0.0, |&i| self.weighed[i].share);
         if settled {
-            top = top.max(self.weighed.first().map_or(0.0, |w| w.probability));
+            top = top.max(self.weighed.first().map_or(0.0, |w| w.share));
         }
         of_len
             .into_iter()
             .filter(|&i| self.weighed[i].walks.is_none())
-            .filter(|&i| search.exhaustive || self.weighed[i].probability >= search.share * top)
+            .filter(|&i| search.exhaustive || wide || self.weighed[i].share >= search.share * top)
             .take(if search.exhaustive {
                 usize::MAX
             } else {
@@ -555,22 +548,35 @@ pub fn weigh(
 
     inp.progress
         .stage("refining the leading single explanations by walks");
-    let singles = st.leading(1, &search, !needs_pairs(&st, decision));
-    st.for_each(&singles, |st, i, key| {
-        refine_single(inp, st, i, search.rounds)?;
-        st.reintegrate(inp, key);
-        Ok(())
+    let single_done = |st: &State| top_walked(st, 1) && walked_fits(st, decision);
+    until_top_walked(&mut st, single_done, |st| {
+        let wide = !walked_fits(st, decision);
+        let singles = st.leading(1, &search, !needs_pairs(st, decision), wide);
+        st.for_each(&singles, |st, i, key| {
+            refine_single(inp, st, i, search.rounds)?;
+            st.reintegrate(inp, key);
+            Ok(())
+        })?;
+        st.normalise(inp);
+        Ok(singles.len())
     })?;
-    st.normalise(inp);
 
     if (search.confirm > 0 && needs_pairs(&st, decision)) || search.exhaustive {
         anchor_at_best_single(inp, &mut st)?;
         inp.progress.stage("confirming the leading pairs by walks");
-        let pairs = st.leading(2, &search, false);
-        st.for_each(&pairs, |st, i, _| confirm_pair(inp, st, i, search.rounds))?;
-        st.normalise(inp);
+        until_top_walked(
+            &mut st,
+            |st| top_walked(st, 2),
+            |st| {
+                let pairs = st.leading(2, &search, false, false);
+                st.for_each(&pairs, |st, i, _| confirm_pair(inp, st, i, search.rounds))?;
+                st.normalise(inp);
+                Ok(pairs.len())
+            },
+        )?;
     }
-    spread_at_leading_modes(inp, &mut st)?;
+    spread_at_walked_modes(inp, &mut st)?;
+    walk_the_top(inp, &mut st, &search)?;
     let anchor = st.surrogate.anchored.as_ref().map(|a| (a.knob, a.x));
     let posterior = Posterior {
         weighed: st.weighed,
@@ -580,28 +586,76 @@ pub fn weigh(
     Ok((posterior, st.slabs))
 }
 
-/// Explanations whose likelihood counts the model's own spread at their mode: the three most
-/// probable ones the search walked (the answer is among them).
-const SPREAD_AT_MODE: usize = 3;
+/// Passes of refinement or confirmation at most, per size of explanation.
+const PASSES: usize = 3;
 
-/// Counts the model's spread at the mode of the most probable walked explanations, until the
-/// leading ones all count it.
-fn spread_at_leading_modes(inp: &Inputs<'_>, st: &mut State) -> Result<(), GapError> {
-    for _ in 0..3 {
-        let todo: Vec<usize> = (0..st.weighed.len())
-            .filter(|&i| {
-                st.weighed[i].walks.is_some() && !st.weighed[i].hypothesis.knobs.is_empty()
-            })
-            .take(SPREAD_AT_MODE)
-            .filter(|&i| st.weighed[i].obs.is_none())
-            .collect();
-        if todo.is_empty() {
+/// Runs `pass` (walks the leading explanations of one size, returns how many) until `done`:
+/// walking the leaders can lift another, seen by the surrogate alone, to the top.
+fn until_top_walked(
+    st: &mut State,
+    done: impl Fn(&State) -> bool,
+    mut pass: impl FnMut(&mut State) -> Result<usize, GapError>,
+) -> Result<(), GapError> {
+    for _ in 0..PASSES {
+        if pass(st)? == 0 || done(st) {
             break;
         }
-        for i in todo {
-            st.spread_at_mode(inp, i)?;
+    }
+    Ok(())
+}
+
+/// Whether the most probable explanation of `len` knobs has been walked.
+fn top_walked(st: &State, len: usize) -> bool {
+    st.weighed
+        .iter()
+        .find(|w| w.hypothesis.knobs.len() == len)
+        .is_none_or(|w| w.walks.is_some())
+}
+
+/// Whether some explanation the search walked passes the posterior-predictive check.
+fn walked_fits(st: &State, decision: &Decision) -> bool {
+    st.weighed
+        .iter()
+        .any(|w| w.walks.is_some() && w.evidence.fit_p >= decision.fit_level)
+}
+
+/// Counts the model's spread at the mode of every explanation the search walked (perturbed
+/// starts there): a knife-edge gait's spread is what lets the explanation that walks it fit.
+fn spread_at_walked_modes(inp: &Inputs<'_>, st: &mut State) -> Result<(), GapError> {
+    let todo: Vec<usize> = (0..st.weighed.len())
+        .filter(|&i| {
+            let w = &st.weighed[i];
+            w.walks.is_some() && !w.hypothesis.knobs.is_empty() && w.obs.is_none()
+        })
+        .collect();
+    for &i in &todo {
+        st.spread_at_mode(inp, i)?;
+    }
+    if !todo.is_empty() {
+        st.normalise(inp);
+    }
+    Ok(())
+}
+
+/// Walks the most probable explanation when only the surrogate has weighed it (counting the
+/// model's spread at the leaders' modes can reorder them), until the top is one the walks
+/// confirmed: the answer always rests on real walks at its most probable point.
+fn walk_the_top(inp: &Inputs<'_>, st: &mut State, search: &Search) -> Result<(), GapError> {
+    for _ in 0..PASSES {
+        let key = match st.weighed.first() {
+            Some(top) if top.walks.is_none() => top.hypothesis.knobs.clone(),
+            _ => break,
+        };
+        match key.len() {
+            1 => {
+                refine_single(inp, st, 0, search.rounds)?;
+                st.reintegrate(inp, &key);
+            }
+            2 => confirm_pair(inp, st, 0, search.rounds)?,
+            _ => break,
         }
         st.normalise(inp);
+        spread_at_walked_modes(inp, st)?;
     }
     Ok(())
 }
@@ -643,15 +697,17 @@ fn anchor_at_best_single(inp: &Inputs<'_>, st: &mut State) -> Result<(), GapErro
     Ok(())
 }
 
-/// Posterior probabilities from priors, evidences and Bayes factors; most probable first (ties
-/// in list order). Every explanation H is weighed alone (prior ∝ its own, evidence Z_H) and
+/// Posterior probabilities from priors, evidences and Bayes factors; most probable first by
+/// their share of the library's mass (ties in list order). Every explanation H is weighed alone (prior ∝ its own, evidence Z_H) and
 /// with "something outside these" beside it (prior `outside_prior` spread in proportion to
 /// H's, evidence Z_H·BF_H): P(outside) = q·E / ((1 − q) + q·E), E the posterior mean of BF,
 /// and each explanation keeps its share of the rest.
-fn normalise(weighed: &mut [Weighed], outside_prior: f64) -> f64 {
+pub fn normalise(weighed: &mut [Weighed], outside_prior: f64) -> f64 {
+    // An evidence that is not a finite number carries no mass (never all of it).
     let logs: Vec<f64> = weighed
         .iter()
         .map(|w| w.hypothesis.prior.ln() + w.evidence.log_z)
+        .map(|l| if l.is_finite() { l } else { f64::NEG_INFINITY })
         .collect();
     let max = logs.iter().copied().fold(f64::NEG_INFINITY, f64::max);
     if !max.is_finite() {
@@ -674,8 +730,9 @@ fn normalise(weighed: &mut [Weighed], outside_prior: f64) -> f64 {
         0.0
     };
     for (w, p) in weighed.iter_mut().zip(&lib) {
+        w.share = *p;
         w.probability = p * (1.0 - outside);
     }
-    weighed.sort_by(|a, b| b.probability.total_cmp(&a.probability));
+    weighed.sort_by(|a, b| b.share.total_cmp(&a.share));
     outside
 }

@@ -9,6 +9,7 @@ mod hypothesis;
 mod knob;
 mod likelihood;
 mod plan;
+mod posterior;
 mod reference;
 mod scoring;
 mod suggest;
