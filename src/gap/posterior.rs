@@ -3,9 +3,9 @@
 //! The criterion is fixed: P(H | trials) ∝ P(H) · Z_H ([`super::hypothesis`],
 //! [`super::evidence`]). The search only decides how well each Z_H is computed: it integrates
 //! every explanation on the additive surrogate, refines the leading singles and confirms the
-//! leading pairs by real walks (the pairs about the best single, [`super::surrogate::Anchored`]),
-//! repeats while the top of either size is unwalked, and walks the overall top last, so that
-//! the answer rests on walks (the steps and why: docs/gap-criterion.md, "The search").
+//! leading pairs by walks (pairs about the best single, [`super::surrogate::Anchored`]),
+//! repeats while the top of either size is unwalked or nothing walked fits, and walks the
+//! top last: the answer rests on walks (why: docs/gap-criterion.md, "The search").
 //! [`Search::exhaustive`] refines and confirms every explanation: how misses are measured.
 
 use rayon::prelude::*;
@@ -367,18 +367,12 @@ impl Inputs<'_> {
 }
 
 /// One posterior width along each free knob of an evidence (unit coordinates), kept between
-/// 1/1024 and 1/32 of the range.
+/// 1/1024 and 1/32 of the range; a NaN width (no interval) gives 1/32 (clamp would keep NaN).
+#[expect(clippy::manual_clamp)]
 fn widths(e: &Evidence) -> Vec<f64> {
     e.intervals
         .iter()
-        .map(|[a, b]| {
-            let w = (b - a) / 4.0;
-            if w.is_finite() {
-                w.clamp(1.0 / 1024.0, 1.0 / 32.0)
-            } else {
-                1.0 / 32.0
-            }
-        })
+        .map(|[a, b]| ((b - a) / 4.0).min(1.0 / 32.0).max(1.0 / 1024.0))
         .collect()
 }
 
@@ -566,9 +560,10 @@ pub fn weigh(
         inp.progress.stage("confirming the leading pairs by walks");
         until_top_walked(
             &mut st,
-            |st| top_walked(st, 2),
+            |st| top_walked(st, 2) && walked_fits(st, decision),
             |st| {
-                let pairs = st.leading(2, &search, false, false);
+                let wide = !walked_fits(st, decision);
+                let pairs = st.leading(2, &search, false, wide);
                 st.for_each(&pairs, |st, i, _| confirm_pair(inp, st, i, search.rounds))?;
                 st.normalise(inp);
                 Ok(pairs.len())
@@ -698,10 +693,10 @@ fn anchor_at_best_single(inp: &Inputs<'_>, st: &mut State) -> Result<(), GapErro
 }
 
 /// Posterior probabilities from priors, evidences and Bayes factors; most probable first by
-/// their share of the library's mass (ties in list order). Every explanation H is weighed alone (prior ∝ its own, evidence Z_H) and
-/// with "something outside these" beside it (prior `outside_prior` spread in proportion to
-/// H's, evidence Z_H·BF_H): P(outside) = q·E / ((1 − q) + q·E), E the posterior mean of BF,
-/// and each explanation keeps its share of the rest.
+/// their share of the library's mass (ties in list order). Every explanation H is weighed
+/// alone (prior ∝ its own, evidence Z_H) and with "something outside these" beside it (prior
+/// `outside_prior` spread in proportion to H's, evidence Z_H·BF_H): P(outside) =
+/// q·E / ((1 − q) + q·E), E the posterior mean of BF; each keeps its share of the rest.
 pub fn normalise(weighed: &mut [Weighed], outside_prior: f64) -> f64 {
     // An evidence that is not a finite number carries no mass (never all of it).
     let logs: Vec<f64> = weighed

@@ -547,8 +547,7 @@ pub fn calibration(rows: &[&CaseRow]) -> Calibration {
 
 /// The half of the cases the decision is chosen on (the other verifies it).
 pub fn in_choice_half(r: &CaseRow) -> bool {
-    // FNV-1a's low bit is only the parity of the key's bytes (a seed's last digit decides it),
-    // so the half is the top bit after splitmix64's finalizer, which mixes every bit.
+    // The top bit after splitmix64's finalizer, which mixes every bit of the key's hash.
     let mut z = seed_of(&r.key);
     z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
     z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
@@ -620,9 +619,11 @@ pub struct BenchmarkSummary {
     pub threshold_met: bool,
     pub scores: Vec<ScoreLine>,
     pub coverage: ScoreLine,
-    /// Calibration on every case, and on the half the decision was not chosen on.
+    /// Calibration on every case, on the half the decision was not chosen on, and on the
+    /// cases with a gap (every kind but the nulls, which dominate the first two).
     pub calibration: Calibration,
     pub calibration_held_out: Calibration,
+    pub calibration_gap: Calibration,
     /// Cases diagnosed again with every explanation confirmed, and how often the search's
     /// most probable explanation differed.
     pub search_misses: Option<Score>,
@@ -643,6 +644,8 @@ pub fn summarize(
     let diagnosed: Vec<&CaseRow> = rows.iter().filter(|r| !r.leading.is_empty()).collect();
     let (choice, held): (Vec<&CaseRow>, Vec<&CaseRow>) =
         diagnosed.iter().copied().partition(|r| in_choice_half(r));
+    let mut gap = diagnosed.clone();
+    gap.retain(|r| r.kind != "null");
     let (chosen, threshold_met) = choose(&choice);
     // Without a threshold meeting the bounds, the scores are those of the file's decision.
     let scored_with = if threshold_met { chosen } else { decision_file };
@@ -705,6 +708,7 @@ pub fn summarize(
         coverage,
         calibration: calibration(&diagnosed),
         calibration_held_out: calibration(&held),
+        calibration_gap: calibration(&gap),
         search_misses: search_misses(&diagnosed),
         drake_truth_probability: drake_truth(&diagnosed),
         thresholds,

@@ -95,6 +95,7 @@ pub fn benchmark_md(b: &BenchmarkSummary, command: &str, rules_files: &[String])
         "\n![Reliability diagram: share right against stated probability](gap-benchmark.svg)"
     );
     calibration_md(&mut o, "the held-out half", &b.calibration_held_out);
+    calibration_md(&mut o, "the cases with a gap", &b.calibration_gap);
     drake_md(&mut o, b);
     thresholds_md(&mut o, b);
     o
