@@ -376,52 +376,7 @@ pub fn assemble_feet(spec: &FeetSpec, points: &[FootPoint]) -> FeetStudy {
                     }),
                 });
             }
-            // Reference: the size nearest the design's own, with its 1× foot.
-            let l0 = design.geometry.leg_length_m;
-            let Some(&l_ref) = spec
-                .leg_lengths_m
-                .iter()
-                .min_by(|a, b| (*a / l0).ln().abs().total_cmp(&(*b / l0).ln().abs()))
-            else {
-                continue;
-            };
-            let v1x = |l: f64| {
-                points
-                    .iter()
-                    .filter(of)
-                    .find(|p| p.leg_length_m == l && p.factor == 1.0 && p.walks)
-                    .map(|p| p.velocity_mps)
-            };
-            for &l in &spec.leg_lengths_m {
-                let best = points
-                    .iter()
-                    .filter(of)
-                    .filter(|p| p.leg_length_m == l && p.walks)
-                    .max_by(|a, b| a.velocity_mps.total_cmp(&b.velocity_mps));
-                if let Some(b) = best {
-                    let pred = v1x(l_ref).map(|v| v * (l / l_ref).sqrt());
-                    fastest.push(FastestFoot {
-                        design: design.name.clone(),
-                        contact: c,
-                        leg_length_m: l,
-                        axis: b.axis.clone(),
-                        factor: b.factor,
-                        velocity_mps: b.velocity_mps,
-                        velocity_1x_mps: v1x(l),
-                        reference_leg_length_m: l_ref,
-                        froude_prediction_mps: pred,
-                        excess_over_froude: pred.map(|p| b.velocity_mps / p - 1.0),
-                        paper_velocity_mps: paper.as_ref().and_then(|p| {
-                            p.fastest_foot
-                                .iter()
-                                .find(|f| {
-                                    f.design == design.name && (f.leg_length_m - l).abs() < 1e-9
-                                })
-                                .map(|f| f.velocity_mps)
-                        }),
-                    });
-                }
-            }
+            fastest.extend(fastest_feet(spec, points, design, c, paper.as_ref()));
         }
     }
     let mut pts = points.to_vec();
@@ -436,4 +391,62 @@ pub fn assemble_feet(spec: &FeetSpec, points: &[FootPoint]) -> FeetStudy {
         fastest,
         points: pts,
     }
+}
+
+/// The fastest walking foot of `design` at each size, beside the speed dynamic similarity
+/// predicts from its 1× foot at the size nearest the design's own (and the paper's).
+fn fastest_feet(
+    spec: &FeetSpec,
+    points: &[FootPoint],
+    design: &Design,
+    c: ContactScaling,
+    paper: Option<&super::paper::PaperTable3>,
+) -> Vec<FastestFoot> {
+    let mut fastest = Vec::new();
+    // Reference: the size nearest the design's own, with its 1× foot.
+    let l0 = design.geometry.leg_length_m;
+    let of = |p: &&FootPoint| p.design == design.name && p.contact == c;
+    let Some(&l_ref) = spec
+        .leg_lengths_m
+        .iter()
+        .min_by(|a, b| (*a / l0).ln().abs().total_cmp(&(*b / l0).ln().abs()))
+    else {
+        return Vec::new();
+    };
+    let v1x = |l: f64| {
+        points
+            .iter()
+            .filter(of)
+            .find(|p| p.leg_length_m == l && p.factor == 1.0 && p.walks)
+            .map(|p| p.velocity_mps)
+    };
+    for &l in &spec.leg_lengths_m {
+        let best = points
+            .iter()
+            .filter(of)
+            .filter(|p| p.leg_length_m == l && p.walks)
+            .max_by(|a, b| a.velocity_mps.total_cmp(&b.velocity_mps));
+        if let Some(b) = best {
+            let pred = v1x(l_ref).map(|v| v * (l / l_ref).sqrt());
+            fastest.push(FastestFoot {
+                design: design.name.clone(),
+                contact: c,
+                leg_length_m: l,
+                axis: b.axis.clone(),
+                factor: b.factor,
+                velocity_mps: b.velocity_mps,
+                velocity_1x_mps: v1x(l),
+                reference_leg_length_m: l_ref,
+                froude_prediction_mps: pred,
+                excess_over_froude: pred.map(|p| b.velocity_mps / p - 1.0),
+                paper_velocity_mps: paper.and_then(|p| {
+                    p.fastest_foot
+                        .iter()
+                        .find(|f| f.design == design.name && (f.leg_length_m - l).abs() < 1e-9)
+                        .map(|f| f.velocity_mps)
+                }),
+            });
+        }
+    }
+    fastest
 }

@@ -132,8 +132,8 @@ fn failure(r: &WalkReport) -> String {
         .unwrap_or_else(|| "no_progress".into())
 }
 
-/// The solver: bracket, then bisect to `rel_tol`.
-pub fn min_torque(design: &Design, opts: &MinTorqueOptions) -> Result<MinTorqueResult, SimError> {
+/// `opts`' tolerance and cap in range, or which one is not.
+fn check_options(opts: &MinTorqueOptions) -> Result<(), SimError> {
     if !(opts.rel_tol > 0.0 && opts.rel_tol < 0.5) {
         return Err(SimError::InvalidOption {
             option: "rel_tol".into(),
@@ -146,6 +146,69 @@ pub fn min_torque(design: &Design, opts: &MinTorqueOptions) -> Result<MinTorqueR
             reason: format!("must be finite and > 0, got {}", opts.cap_over_mgl),
         });
     }
+    Ok(())
+}
+
+/// A bracket: the failing torque, the walking one, the walk there and the failure below.
+type Bracket = (f64, f64, WalkReport, WalkReport);
+
+/// Brackets the minimum torque from `start`, stepping by `ratio`, which squares (up to 2) at
+/// every step that does not close the bracket. None when the search ends without one, with
+/// `result` filled: a passive gait (walks with almost no torque), or no walk up to `cap`.
+fn bracket(
+    problem: &mut WalksAt<'_>,
+    start: f64,
+    mut ratio: f64,
+    [mgl, cap]: [f64; 2],
+    result: &mut MinTorqueResult,
+) -> Result<Option<Bracket>, SimError> {
+    match problem.evaluate(start)? {
+        Ok(g) => {
+            let (mut hi, mut gait) = (start, g);
+            loop {
+                let t = hi / ratio;
+                if t < 1e-4 * mgl {
+                    result.walks = true;
+                    result.min_torque_nm = Some(t);
+                    result.min_torque_over_mgl = Some(t / mgl);
+                    result.bracket_nm = Some([0.0, t]);
+                    result.gait = Some(gait);
+                    return Ok(None);
+                }
+                match problem.evaluate(t)? {
+                    Ok(g) => {
+                        hi = t;
+                        gait = g;
+                        ratio = (ratio * ratio).min(2.0);
+                    }
+                    Err(f) => return Ok(Some((t, hi, gait, f))),
+                }
+            }
+        }
+        Err(f) => {
+            let (mut lo, mut fail) = (start, f);
+            loop {
+                if lo >= cap {
+                    result.failure_below = Some(failure(&fail));
+                    return Ok(None);
+                }
+                let t = (lo * ratio).min(cap);
+                match problem.evaluate(t)? {
+                    Ok(g) => return Ok(Some((lo, t, g, fail))),
+                    Err(f) => {
+                        lo = t;
+                        fail = f;
+                        ratio = (ratio * ratio).min(2.0);
+                    }
+                }
+            }
+        }
+    }
+}
+
+/// The solver: bracket, then bisect to `rel_tol`.
+pub fn min_torque(design: &Design, opts: &MinTorqueOptions) -> Result<MinTorqueResult, SimError> {
+    check_options(opts)?;
     let scaled = design.scaled(
         opts.walk
             .leg_length_m
@@ -159,7 +222,7 @@ pub fn min_torque(design: &Design, opts: &MinTorqueOptions) -> Result<MinTorqueR
     let cap = opts.cap_over_mgl * mgl;
     // First torque and first step ratio: the warm bracket's walking end and width, or the
     // design's own torque and a factor 2.
-    let (start, mut ratio) = match opts.start_bracket_nm {
+    let (start, ratio) = match opts.start_bracket_nm {
         Some([lo, hi]) if lo > 0.0 && hi > lo && hi.is_finite() => {
             (hi, (hi / lo).max(1.0 + 0.5 * opts.rel_tol))
         }
@@ -200,54 +263,11 @@ pub fn min_torque(design: &Design, opts: &MinTorqueOptions) -> Result<MinTorqueR
         failure_below: None,
         criterion,
     };
-    // Bracket: [lo fails, hi walks], stepping by `ratio`, which squares (up to 2) at every
-    // step that does not close the bracket.
-    let (mut lo, mut hi, mut gait, mut below) = match problem.evaluate(start)? {
-        Ok(g) => {
-            let mut hi = start;
-            let mut gait = g;
-            loop {
-                let t = hi / ratio;
-                if t < 1e-4 * mgl {
-                    // Walks with (almost) no torque: a passive gait; report the floor.
-                    result.walks = true;
-                    result.min_torque_nm = Some(t);
-                    result.min_torque_over_mgl = Some(t / mgl);
-                    result.bracket_nm = Some([0.0, t]);
-                    result.walks_evaluated = problem.evaluated;
-                    result.gait = Some(gait);
-                    return Ok(result);
-                }
-                match problem.evaluate(t)? {
-                    Ok(g) => {
-                        hi = t;
-                        gait = g;
-                        ratio = (ratio * ratio).min(2.0);
-                    }
-                    Err(f) => break (t, hi, gait, f),
-                }
-            }
-        }
-        Err(f) => {
-            let mut lo = start;
-            let mut fail = f;
-            loop {
-                if lo >= cap {
-                    result.failure_below = Some(failure(&fail));
-                    result.walks_evaluated = problem.evaluated;
-                    return Ok(result);
-                }
-                let t = (lo * ratio).min(cap);
-                match problem.evaluate(t)? {
-                    Ok(g) => break (lo, t, g, fail),
-                    Err(f) => {
-                        lo = t;
-                        fail = f;
-                        ratio = (ratio * ratio).min(2.0);
-                    }
-                }
-            }
-        }
+    let Some((mut lo, mut hi, mut gait, mut below)) =
+        bracket(&mut problem, start, ratio, [mgl, cap], &mut result)?
+    else {
+        result.walks_evaluated = problem.evaluated;
+        return Ok(result);
     };
     while (hi - lo) / hi > opts.rel_tol {
         let mid = 0.5 * (lo + hi);
