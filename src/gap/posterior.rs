@@ -542,33 +542,11 @@ pub fn weigh(
 
     inp.progress
         .stage("refining the leading single explanations by walks");
-    let single_done = |st: &State| top_walked(st, 1) && walked_fits(st, decision);
-    until_top_walked(&mut st, single_done, |st| {
-        let wide = !walked_fits(st, decision);
-        let singles = st.leading(1, &search, !needs_pairs(st, decision), wide);
-        st.for_each(&singles, |st, i, key| {
-            refine_single(inp, st, i, search.rounds)?;
-            st.reintegrate(inp, key);
-            Ok(())
-        })?;
-        st.normalise(inp);
-        Ok(singles.len())
-    })?;
-
+    walk_leaders(inp, &mut st, 1, &search, decision)?;
     if (search.confirm > 0 && needs_pairs(&st, decision)) || search.exhaustive {
         anchor_at_best_single(inp, &mut st)?;
         inp.progress.stage("confirming the leading pairs by walks");
-        until_top_walked(
-            &mut st,
-            |st| top_walked(st, 2) && walked_fits(st, decision),
-            |st| {
-                let wide = !walked_fits(st, decision);
-                let pairs = st.leading(2, &search, false, wide);
-                st.for_each(&pairs, |st, i, _| confirm_pair(inp, st, i, search.rounds))?;
-                st.normalise(inp);
-                Ok(pairs.len())
-            },
-        )?;
+        walk_leaders(inp, &mut st, 2, &search, decision)?;
     }
     spread_at_walked_modes(inp, &mut st)?;
     walk_the_top(inp, &mut st, &search)?;
@@ -584,17 +562,40 @@ pub fn weigh(
 /// Passes of refinement or confirmation at most, per size of explanation.
 const PASSES: usize = 3;
 
-/// Runs `pass` (walks the leading explanations of one size, returns how many) until `done`:
-/// walking the leaders can lift another, seen by the surrogate alone, to the top.
-fn until_top_walked(
+/// Walks the leading explanations of `len` knobs, pass after pass, until the top one of that
+/// size is walked and some walked explanation fits: walking the leaders can lift another,
+/// seen by the surrogate alone, to the top; while nothing fits the share floor is dropped.
+fn walk_leaders(
+    inp: &Inputs<'_>,
     st: &mut State,
-    done: impl Fn(&State) -> bool,
-    mut pass: impl FnMut(&mut State) -> Result<usize, GapError>,
+    len: usize,
+    search: &Search,
+    decision: &Decision,
 ) -> Result<(), GapError> {
     for _ in 0..PASSES {
-        if pass(st)? == 0 || done(st) {
+        let wide = !walked_fits(st, decision);
+        let settled = len == 1 && !needs_pairs(st, decision);
+        let leaders = st.leading(len, search, settled, wide);
+        st.for_each(&leaders, |st, i, _| walk_one(inp, st, i, search.rounds))?;
+        st.normalise(inp);
+        if leaders.is_empty() || (top_walked(st, len) && walked_fits(st, decision)) {
             break;
         }
+    }
+    Ok(())
+}
+
+/// Walks explanation `i`: refines a single (and integrates again the pairs holding its knob),
+/// confirms a pair.
+fn walk_one(inp: &Inputs<'_>, st: &mut State, i: usize, rounds: usize) -> Result<(), GapError> {
+    let key = st.weighed[i].hypothesis.knobs.clone();
+    match key.len() {
+        1 => {
+            refine_single(inp, st, i, rounds)?;
+            st.reintegrate(inp, &key);
+        }
+        2 => confirm_pair(inp, st, i, rounds)?,
+        _ => {}
     }
     Ok(())
 }
@@ -637,18 +638,11 @@ fn spread_at_walked_modes(inp: &Inputs<'_>, st: &mut State) -> Result<(), GapErr
 /// confirmed: the answer always rests on real walks at its most probable point.
 fn walk_the_top(inp: &Inputs<'_>, st: &mut State, search: &Search) -> Result<(), GapError> {
     for _ in 0..PASSES {
-        let key = match st.weighed.first() {
-            Some(top) if top.walks.is_none() => top.hypothesis.knobs.clone(),
-            _ => break,
-        };
-        match key.len() {
-            1 => {
-                refine_single(inp, st, 0, search.rounds)?;
-                st.reintegrate(inp, &key);
-            }
-            2 => confirm_pair(inp, st, 0, search.rounds)?,
+        match st.weighed.first() {
+            Some(top) if top.walks.is_none() && (1..=2).contains(&top.hypothesis.knobs.len()) => {}
             _ => break,
         }
+        walk_one(inp, st, 0, search.rounds)?;
         st.normalise(inp);
         spread_at_walked_modes(inp, st)?;
     }
