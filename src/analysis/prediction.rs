@@ -331,44 +331,9 @@ pub fn predict(
     }
     let inverse = match req.mass_budget_kg {
         None => None,
-        Some(m) => {
-            let m = positive("mass budget", m)?;
-            let cf = &mass_fit;
-            let inv = regression::inverse_predict_ols(&cf.fit.log_fit, m.log10(), req.confidence)
-                .map_err(|e| cf.error(e))?;
-            let l = 10f64.powf(inv.x0);
-            let extrapolation = range_warning("leg length", l, "m", cf.law.x_range, class);
-            Some(InversePrediction {
-                mass_budget_kg: m,
-                leg_length_m: l,
-                leg_length_ci: inv
-                    .x0_ci
-                    .map(|c| [10f64.powf(c.lower), 10f64.powf(c.upper)]),
-                law: cf.law.clone(),
-                extrapolation,
-            })
-        }
+        Some(m) => Some(inverse_prediction(&mass_fit, m, req.confidence, class)?),
     };
-    let scaled_reference = match (&req.reference, req.leg_length_m) {
-        (Some(r), Some(l)) => {
-            positive("reference leg length", r.leg_length_m)?;
-            positive("reference mass", r.mass_kg)?;
-            let s = l / r.leg_length_m;
-            Some(ScaledReference {
-                reference: r.clone(),
-                scale_factor: s,
-                mass_l2_kg: r.mass_kg * s * s,
-                mass_l3_kg: r.mass_kg * s * s * s,
-                body_length_isometric_m: r.body_length_m.map(|b| b * s),
-            })
-        }
-        (Some(_), None) => {
-            return Err(PredictError::Request(
-                "--from scales a reference to a target leg length: give --leg-length too".into(),
-            ));
-        }
-        _ => None,
-    };
+    let scaled_reference = scaled_reference(req)?;
     Ok(Prediction {
         dataset: DatasetRef::of(table),
         class,
@@ -383,6 +348,53 @@ pub fn predict(
         froude: froude_at,
         speed_unavailable,
     })
+}
+
+/// The inverse query: the leg length at which the class's mass law gives the mass budget
+/// `m` (its median), with its confidence interval.
+fn inverse_prediction(
+    cf: &ClassFit,
+    m: f64,
+    confidence: f64,
+    class: Group,
+) -> Result<InversePrediction, PredictError> {
+    let m = positive("mass budget", m)?;
+    let inv = regression::inverse_predict_ols(&cf.fit.log_fit, m.log10(), confidence)
+        .map_err(|e| cf.error(e))?;
+    let l = 10f64.powf(inv.x0);
+    let extrapolation = range_warning("leg length", l, "m", cf.law.x_range, class);
+    Ok(InversePrediction {
+        mass_budget_kg: m,
+        leg_length_m: l,
+        leg_length_ci: inv
+            .x0_ci
+            .map(|c| [10f64.powf(c.lower), 10f64.powf(c.upper)]),
+        law: cf.law.clone(),
+        extrapolation,
+    })
+}
+
+/// The request's reference robot scaled isometrically to the target leg length (mass under
+/// m ∝ L² and m ∝ L³); an error when a reference is given without a target leg length.
+fn scaled_reference(req: &PredictRequest) -> Result<Option<ScaledReference>, PredictError> {
+    match (&req.reference, req.leg_length_m) {
+        (Some(r), Some(l)) => {
+            positive("reference leg length", r.leg_length_m)?;
+            positive("reference mass", r.mass_kg)?;
+            let s = l / r.leg_length_m;
+            Ok(Some(ScaledReference {
+                reference: r.clone(),
+                scale_factor: s,
+                mass_l2_kg: r.mass_kg * s * s,
+                mass_l3_kg: r.mass_kg * s * s * s,
+                body_length_isometric_m: r.body_length_m.map(|b| b * s),
+            }))
+        }
+        (Some(_), None) => Err(PredictError::Request(
+            "--from scales a reference to a target leg length: give --leg-length too".into(),
+        )),
+        _ => Ok(None),
+    }
 }
 
 /// The speed of the requested kind at leg length `l`, or why the class cannot predict it

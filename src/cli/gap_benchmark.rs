@@ -238,40 +238,11 @@ pub fn benchmark(a: &BenchmarkArgs) -> anyhow::Result<ExitCode> {
     };
     pb.stage("planning the cases");
     let mut plan = gap::plan::plan(&lib, &opts, &pb)?;
-    use gap::plan::KINDS;
-    if let Some(bad) = a.kinds.iter().find(|k| !KINDS.contains(&k.as_str())) {
-        anyhow::bail!(
-            "--kinds {bad}: not a case kind (one of {})",
-            KINDS.join(", ")
-        );
-    }
-    if !a.kinds.is_empty() {
-        plan.cases.retain(|c| a.kinds.contains(&c.kind));
-    }
-    if !a.keys.is_empty() {
-        plan.cases
-            .retain(|c| a.keys.iter().any(|k| c.key.contains(k.as_str())));
-        anyhow::ensure!(
-            !plan.cases.is_empty(),
-            "--keys {}: no case has such a key",
-            a.keys.join(",")
-        );
-    }
+    select_cases(&mut plan, a)?;
     let rows = if a.merge.is_empty() {
         gap::benchmark::run(&lib, &opts, &plan, a.points.as_deref(), shard, &pb)?
     } else {
-        let Some(target) = &a.points else {
-            anyhow::bail!("--merge needs --points FILE (the merged file)");
-        };
-        let (header, mut rows) =
-            robot_survey::checkpoint::merge::<gap::benchmark::CaseRow>(&a.merge)?;
-        anyhow::ensure!(
-            header == gap::benchmark::spec(&opts),
-            "the merged files were written with other benchmark options than these"
-        );
-        robot_survey::checkpoint::finish_points(target, &header, &rows)?;
-        rows.sort_by(|x, y| x.key.cmp(&y.key));
-        rows
+        merged_rows(a, &opts)?
     };
     pb.clear();
     if shard != Shard::WHOLE {
@@ -306,6 +277,50 @@ pub fn benchmark(a: &BenchmarkArgs) -> anyhow::Result<ExitCode> {
     eprintln!("wrote {}/gap-benchmark.{{md,json,svg}}", out.display());
     print(&md);
     Ok(ExitCode::SUCCESS)
+}
+
+/// Keeps the planned cases of the `--kinds` and `--keys` asked for (all when none is
+/// given); an unknown kind, or keys that match no case, is an error.
+fn select_cases(plan: &mut gap::plan::Plan, a: &BenchmarkArgs) -> anyhow::Result<()> {
+    use gap::plan::KINDS;
+    if let Some(bad) = a.kinds.iter().find(|k| !KINDS.contains(&k.as_str())) {
+        anyhow::bail!(
+            "--kinds {bad}: not a case kind (one of {})",
+            KINDS.join(", ")
+        );
+    }
+    if !a.kinds.is_empty() {
+        plan.cases.retain(|c| a.kinds.contains(&c.kind));
+    }
+    if !a.keys.is_empty() {
+        plan.cases
+            .retain(|c| a.keys.iter().any(|k| c.key.contains(k.as_str())));
+        anyhow::ensure!(
+            !plan.cases.is_empty(),
+            "--keys {}: no case has such a key",
+            a.keys.join(",")
+        );
+    }
+    Ok(())
+}
+
+/// The rows of the `--merge` points files, written to the `--points` file and sorted by
+/// key; the files must have been made with these benchmark options.
+fn merged_rows(
+    a: &BenchmarkArgs,
+    opts: &gap::plan::BenchmarkOptions,
+) -> anyhow::Result<Vec<gap::benchmark::CaseRow>> {
+    let Some(target) = &a.points else {
+        anyhow::bail!("--merge needs --points FILE (the merged file)");
+    };
+    let (header, mut rows) = robot_survey::checkpoint::merge::<gap::benchmark::CaseRow>(&a.merge)?;
+    anyhow::ensure!(
+        header == gap::benchmark::spec(opts),
+        "the merged files were written with other benchmark options than these"
+    );
+    robot_survey::checkpoint::finish_points(target, &header, &rows)?;
+    rows.sort_by(|x, y| x.key.cmp(&y.key));
+    Ok(rows)
 }
 
 /// Effects that stand for a declared uncertain parameter of the design, as the parameter's

@@ -264,41 +264,7 @@ fn check_actuators(file: &MotorFile, actuators: &[Actuator]) -> Vec<MotorProblem
     for a in actuators {
         let id = a.id.as_str();
         s.id(id, &mut seen, "actuator id");
-        if let Some(m) = a.mass_kg {
-            s.number(id, "mass_kg", m, MASS_KG, "kg");
-        }
-        if let Some(g) = a.gear_ratio {
-            s.positive(id, "gear_ratio", g);
-        }
-        if let Some(v) = a.recommended_voltage_v {
-            s.number(id, "recommended_voltage_v", v, VOLTAGE_V, "V");
-            if v.is_finite() && a.rating(Some(v)).is_none() {
-                s.error(
-                    Rule::Consistency,
-                    id,
-                    "recommended_voltage_v",
-                    format!("no rating at the recommended voltage {v} V"),
-                );
-            }
-        }
-        if let Some(t) = a.continuous_torque_nm {
-            s.number(id, "continuous_torque_nm", t, STALL_TORQUE_NM, "N·m");
-            let max_stall = a
-                .ratings
-                .iter()
-                .map(|r| r.stall_torque_nm)
-                .fold(f64::NAN, f64::max);
-            if t > max_stall {
-                s.warning(
-                    Rule::Consistency,
-                    id,
-                    "continuous_torque_nm",
-                    format!(
-                        "continuous torque {t} N·m exceeds every stall torque (max {max_stall} N·m)"
-                    ),
-                );
-            }
-        }
+        check_actuator_numbers(&mut s, id, a);
         if a.ratings.is_empty() {
             s.error(
                 Rule::MissingField,
@@ -307,89 +273,141 @@ fn check_actuators(file: &MotorFile, actuators: &[Actuator]) -> Vec<MotorProblem
                 "an actuator needs at least one rating".into(),
             );
         }
-        let mut voltages: Vec<f64> = Vec::new();
-        for (i, r) in a.ratings.iter().enumerate() {
-            let f = |k: &str| format!("ratings[{i}].{k}");
-            if let Some(v) = r.voltage_v {
-                s.number(id, &f("voltage_v"), v, VOLTAGE_V, "V");
-                if voltages
-                    .iter()
-                    .any(|w| (w - v).abs() <= super::VOLTAGE_TOLERANCE_V)
-                {
-                    s.error(
-                        Rule::Duplicate,
-                        id,
-                        &f("voltage_v"),
-                        format!("two ratings at {v} V"),
-                    );
-                }
-                voltages.push(v);
-            }
-            s.number(
-                id,
-                &f("stall_torque_nm"),
-                r.stall_torque_nm,
-                STALL_TORQUE_NM,
-                "N·m",
-            );
-            if let Some(w) = r.no_load_speed_rpm {
-                s.number(id, &f("no_load_speed_rpm"), w, NO_LOAD_SPEED_RPM, "rpm");
-            }
-            if let Some(c) = r.stall_current_a {
-                s.positive(id, &f("stall_current_a"), c);
-            }
-            if let Some(m) = a.mass_kg
-                && m.is_finite()
-                && m > 0.0
-                && r.stall_torque_nm.is_finite()
-            {
-                let specific = r.stall_torque_nm / m;
-                if specific < SPECIFIC_STALL_TORQUE.0 || specific > SPECIFIC_STALL_TORQUE.1 {
-                    s.warning(
-                        Rule::UnitPlausibility,
-                        id,
-                        &f("stall_torque_nm"),
-                        format!(
-                            "mass-specific stall torque {specific:.3} N·m/kg ({} N·m / {m} kg) is outside {}–{} N·m/kg: a unit slip?",
-                            r.stall_torque_nm, SPECIFIC_STALL_TORQUE.0, SPECIFIC_STALL_TORQUE.1
-                        ),
-                    );
-                }
-            }
-        }
-        if a.stall_torque_basis != StallTorqueBasis::Datasheet
-            && a.note.as_deref().is_none_or(|n| n.trim().is_empty())
-        {
+        check_ratings(&mut s, id, a);
+        check_actuator_provenance(&mut s, id, a);
+    }
+    s.out
+}
+
+/// The actuator-wide numbers: mass, gear ratio, the recommended voltage (which must have a
+/// rating) and the continuous torque (which should not exceed every stall torque).
+fn check_actuator_numbers(s: &mut Sink<'_>, id: &str, a: &Actuator) {
+    if let Some(m) = a.mass_kg {
+        s.number(id, "mass_kg", m, MASS_KG, "kg");
+    }
+    if let Some(g) = a.gear_ratio {
+        s.positive(id, "gear_ratio", g);
+    }
+    if let Some(v) = a.recommended_voltage_v {
+        s.number(id, "recommended_voltage_v", v, VOLTAGE_V, "V");
+        if v.is_finite() && a.rating(Some(v)).is_none() {
             s.error(
-                Rule::Provenance,
+                Rule::Consistency,
                 id,
-                "note",
-                format!(
-                    "stall_torque_basis `{}` needs a note saying what the torque is",
-                    basis_name(a.stall_torque_basis)
-                ),
-            );
-        }
-        match &a.source.url {
-            Some(u) => s.url(id, "source.url", u),
-            None if a.source.kind == SourceKind::Datasheet => s.error(
-                Rule::Provenance,
-                id,
-                "source.url",
-                "a datasheet source needs a URL".into(),
-            ),
-            None => {}
-        }
-        if a.source.at.trim().is_empty() {
-            s.error(
-                Rule::Provenance,
-                id,
-                "source.at",
-                "say where in the source the numbers are".into(),
+                "recommended_voltage_v",
+                format!("no rating at the recommended voltage {v} V"),
             );
         }
     }
-    s.out
+    if let Some(t) = a.continuous_torque_nm {
+        s.number(id, "continuous_torque_nm", t, STALL_TORQUE_NM, "N·m");
+        let max_stall = a
+            .ratings
+            .iter()
+            .map(|r| r.stall_torque_nm)
+            .fold(f64::NAN, f64::max);
+        if t > max_stall {
+            s.warning(
+                Rule::Consistency,
+                id,
+                "continuous_torque_nm",
+                format!(
+                    "continuous torque {t} N·m exceeds every stall torque (max {max_stall} N·m)"
+                ),
+            );
+        }
+    }
+}
+
+/// Each rating's numbers, one rating per voltage, and its mass-specific stall torque (a
+/// value far outside the servos' range is most likely a unit slip).
+fn check_ratings(s: &mut Sink<'_>, id: &str, a: &Actuator) {
+    let mut voltages: Vec<f64> = Vec::new();
+    for (i, r) in a.ratings.iter().enumerate() {
+        let f = |k: &str| format!("ratings[{i}].{k}");
+        if let Some(v) = r.voltage_v {
+            s.number(id, &f("voltage_v"), v, VOLTAGE_V, "V");
+            if voltages
+                .iter()
+                .any(|w| (w - v).abs() <= super::VOLTAGE_TOLERANCE_V)
+            {
+                s.error(
+                    Rule::Duplicate,
+                    id,
+                    &f("voltage_v"),
+                    format!("two ratings at {v} V"),
+                );
+            }
+            voltages.push(v);
+        }
+        s.number(
+            id,
+            &f("stall_torque_nm"),
+            r.stall_torque_nm,
+            STALL_TORQUE_NM,
+            "N·m",
+        );
+        if let Some(w) = r.no_load_speed_rpm {
+            s.number(id, &f("no_load_speed_rpm"), w, NO_LOAD_SPEED_RPM, "rpm");
+        }
+        if let Some(c) = r.stall_current_a {
+            s.positive(id, &f("stall_current_a"), c);
+        }
+        if let Some(m) = a.mass_kg
+            && m.is_finite()
+            && m > 0.0
+            && r.stall_torque_nm.is_finite()
+        {
+            let specific = r.stall_torque_nm / m;
+            if specific < SPECIFIC_STALL_TORQUE.0 || specific > SPECIFIC_STALL_TORQUE.1 {
+                s.warning(
+                    Rule::UnitPlausibility,
+                    id,
+                    &f("stall_torque_nm"),
+                    format!(
+                        "mass-specific stall torque {specific:.3} N·m/kg ({} N·m / {m} kg) is outside {}–{} N·m/kg: a unit slip?",
+                        r.stall_torque_nm, SPECIFIC_STALL_TORQUE.0, SPECIFIC_STALL_TORQUE.1
+                    ),
+                );
+            }
+        }
+    }
+}
+
+/// Where the numbers come from: a note for a stall torque that is not the datasheet's, a
+/// URL for a datasheet source (any URL must be http(s)), and where in the source to look.
+fn check_actuator_provenance(s: &mut Sink<'_>, id: &str, a: &Actuator) {
+    if a.stall_torque_basis != StallTorqueBasis::Datasheet
+        && a.note.as_deref().is_none_or(|n| n.trim().is_empty())
+    {
+        s.error(
+            Rule::Provenance,
+            id,
+            "note",
+            format!(
+                "stall_torque_basis `{}` needs a note saying what the torque is",
+                basis_name(a.stall_torque_basis)
+            ),
+        );
+    }
+    match &a.source.url {
+        Some(u) => s.url(id, "source.url", u),
+        None if a.source.kind == SourceKind::Datasheet => s.error(
+            Rule::Provenance,
+            id,
+            "source.url",
+            "a datasheet source needs a URL".into(),
+        ),
+        None => {}
+    }
+    if a.source.at.trim().is_empty() {
+        s.error(
+            Rule::Provenance,
+            id,
+            "source.at",
+            "say where in the source the numbers are".into(),
+        );
+    }
 }
 
 fn basis_name(b: StallTorqueBasis) -> &'static str {

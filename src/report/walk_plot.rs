@@ -80,6 +80,8 @@ type Series = (
     fn(&TrajectorySample) -> f64,
 );
 
+/// Draws the two panels into `svg` and returns their text, which [`render_svg`] adds as
+/// plain SVG elements afterwards.
 fn draw(svg: &mut String, samples: &[TrajectorySample], title: &str) -> Result<Vec<Label>, String> {
     let e = |x: DrawingAreaErrorKind<_>| x.to_string();
     let mut labels = Vec::new();
@@ -94,22 +96,19 @@ fn draw(svg: &mut String, samples: &[TrajectorySample], title: &str) -> Result<V
         color: "black",
         rotate: false,
     });
+    draw_angles(&left, samples, &mut labels)?;
+    draw_path(&right, samples, &mut labels)?;
+    root.present().map_err(e)?;
+    Ok(labels)
+}
 
-    // Time series.
-    let t0 = samples.first().map(|s| s.t_s).unwrap_or(0.0);
-    let t1 = samples.last().map(|s| s.t_s).unwrap_or(1.0).max(t0 + 1e-6);
-    let series: [Series; 4] = [
-        ("roll", "#d62728", RGBColor(214, 39, 40), |s| s.roll_deg),
-        ("pitch", "#1f77b4", RGBColor(31, 119, 180), |s| s.pitch_deg),
-        ("yaw", "#2ca02c", RGBColor(44, 160, 44), |s| s.yaw_deg),
-        ("hip angle", "#7f7f7f", RGBColor(127, 127, 127), |s| {
-            s.hip_angle_deg
-        }),
-    ];
+/// Value range of the series over the samples, padded by 5 % either side ([-1, 1] before
+/// padding when nothing finite or no spread), so every curve sits inside the frame.
+fn angle_range(samples: &[TrajectorySample], series: &[Series]) -> (f64, f64) {
     let mut lo = f64::INFINITY;
     let mut hi = f64::NEG_INFINITY;
     for s in samples {
-        for (_, _, _, f) in &series {
+        for (_, _, _, f) in series {
             let v = f(s);
             if v.is_finite() {
                 lo = lo.min(v);
@@ -122,15 +121,35 @@ fn draw(svg: &mut String, samples: &[TrajectorySample], title: &str) -> Result<V
         hi = 1.0;
     }
     let pad = 0.05 * (hi - lo);
-    let (lo, hi) = (lo - pad, hi + pad);
-    let mut c = ChartBuilder::on(&left)
+    (lo - pad, hi + pad)
+}
+
+/// Left panel: roll, pitch, yaw and hip angle over time, with their legend and axis titles.
+fn draw_angles(
+    area: &Area<'_>,
+    samples: &[TrajectorySample],
+    labels: &mut Vec<Label>,
+) -> Result<(), String> {
+    let e = |x: DrawingAreaErrorKind<_>| x.to_string();
+    let t0 = samples.first().map(|s| s.t_s).unwrap_or(0.0);
+    let t1 = samples.last().map(|s| s.t_s).unwrap_or(1.0).max(t0 + 1e-6);
+    let series: [Series; 4] = [
+        ("roll", "#d62728", RGBColor(214, 39, 40), |s| s.roll_deg),
+        ("pitch", "#1f77b4", RGBColor(31, 119, 180), |s| s.pitch_deg),
+        ("yaw", "#2ca02c", RGBColor(44, 160, 44), |s| s.yaw_deg),
+        ("hip angle", "#7f7f7f", RGBColor(127, 127, 127), |s| {
+            s.hip_angle_deg
+        }),
+    ];
+    let (lo, hi) = angle_range(samples, &series);
+    let mut c = ChartBuilder::on(area)
         .margin_left(70)
         .margin_right(20)
         .margin_top(60)
         .margin_bottom(50)
         .build_cartesian_2d(t0..t1, lo..hi)
         .map_err(e)?;
-    grid_and_frame(&mut c, (t0, t1), (lo, hi), 8, &mut labels)?;
+    grid_and_frame(&mut c, (t0, t1), (lo, hi), 8, labels)?;
     for (i, (name, hex, col, f)) in series.iter().enumerate() {
         c.draw_series(LineSeries::new(samples.iter().map(|s| (s.t_s, f(s))), col))
             .map_err(e)?;
@@ -161,10 +180,12 @@ fn draw(svg: &mut String, samples: &[TrajectorySample], title: &str) -> Result<V
         color: "black",
         rotate: true,
     });
+    Ok(())
+}
 
-    // Path from above, equal axes.
-    let xs: Vec<f64> = samples.iter().map(|s| s.x_m).collect();
-    let ys: Vec<f64> = samples.iter().map(|s| s.y_m).collect();
+/// Square window (x0, x1, y0, y1) around the path, 10 % wider than its larger extent, so
+/// the top view keeps equal axes.
+fn path_window(xs: &[f64], ys: &[f64]) -> (f64, f64, f64, f64) {
     let (mut x0, mut x1) = xs
         .iter()
         .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &v| {
@@ -180,20 +201,32 @@ fn draw(svg: &mut String, samples: &[TrajectorySample], title: &str) -> Result<V
     }
     let span = (x1 - x0).max(y1 - y0).max(1e-3) * 1.1;
     let (cx, cy) = (0.5 * (x0 + x1), 0.5 * (y0 + y1));
-    let (x0, x1, y0, y1) = (
+    (
         cx - 0.5 * span,
         cx + 0.5 * span,
         cy - 0.5 * span,
         cy + 0.5 * span,
-    );
-    let mut p = ChartBuilder::on(&right)
+    )
+}
+
+/// Right panel: the hip point's path seen from above, on equal axes, with axis titles.
+fn draw_path(
+    area: &Area<'_>,
+    samples: &[TrajectorySample],
+    labels: &mut Vec<Label>,
+) -> Result<(), String> {
+    let e = |x: DrawingAreaErrorKind<_>| x.to_string();
+    let xs: Vec<f64> = samples.iter().map(|s| s.x_m).collect();
+    let ys: Vec<f64> = samples.iter().map(|s| s.y_m).collect();
+    let (x0, x1, y0, y1) = path_window(&xs, &ys);
+    let mut p = ChartBuilder::on(area)
         .margin_left(70)
         .margin_right(20)
         .margin_top(60)
         .margin_bottom(50)
         .build_cartesian_2d(x0..x1, y0..y1)
         .map_err(e)?;
-    grid_and_frame(&mut p, (x0, x1), (y0, y1), 5, &mut labels)?;
+    grid_and_frame(&mut p, (x0, x1), (y0, y1), 5, labels)?;
     p.draw_series(LineSeries::new(
         xs.iter().copied().zip(ys.iter().copied()),
         &RGBColor(148, 103, 189),
@@ -217,8 +250,7 @@ fn draw(svg: &mut String, samples: &[TrajectorySample], title: &str) -> Result<V
         color: "black",
         rotate: true,
     });
-    root.present().map_err(e)?;
-    Ok(labels)
+    Ok(())
 }
 
 fn escape(s: &str) -> String {

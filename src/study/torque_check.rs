@@ -20,6 +20,7 @@ use serde::Serialize;
 use super::StudyError;
 use super::table3::{Table3Point, Table3Row};
 use crate::motors::{Actuator, MotorCatalogue, Quantity, SizeVariable, SourceKind};
+use crate::regression::PowerLawFit;
 use crate::sim::{ContactScaling, MassLaw};
 
 /// How actuator size follows robot size.
@@ -147,18 +148,7 @@ pub fn torque_check(
     design_mass_at: &dyn Fn(f64) -> f64,
 ) -> Result<TorqueCheck, StudyError> {
     let (actuator, voltage, l0) = resolve_anchor(row, catalogue, anchor, anchor_leg_length_m)?;
-    let tau0 = actuator
-        .stall_torque_at(voltage)
-        .ok_or_else(|| StudyError::InvalidOption {
-            option: "voltage".into(),
-            reason: format!(
-                "actuator `{}` has no rating at {}",
-                actuator.id,
-                voltage
-                    .map(|v| format!("{v} V"))
-                    .unwrap_or("its recommended voltage".into())
-            ),
-        })?;
+    let tau0 = anchor_stall_torque(actuator, voltage)?;
     let m0 = design_mass_at(l0);
     let walking: Vec<&Table3Point> = row
         .points
@@ -176,41 +166,11 @@ pub fn torque_check(
         .len();
     let mut bridges = Vec::new();
     for bridge in [Bridge::IsometricActuator, Bridge::FixedMassFraction] {
-        let mut laws: Vec<(String, String, f64, f64)> = catalogue
-            .laws
-            .iter()
-            .map(|law| {
-                let k = law.exponent;
-                let p = bridge_exponent(bridge, law.size_variable, law.quantity, k, e);
-                (
-                    law.id.clone(),
-                    format!("{:?}", law.basis).to_lowercase(),
-                    k,
-                    p,
-                )
-            })
-            .collect();
-        if let Some(f) = &fit {
-            let p = match bridge {
-                Bridge::IsometricActuator => 3.0 * f.b,
-                Bridge::FixedMassFraction => e * f.b,
-            };
-            laws.push(("catalogue-fit".into(), "catalogue".into(), f.b, p));
-        }
-        let checks = laws
+        let checks = laws_under(bridge, catalogue, fit.as_ref(), e)
             .into_iter()
             .map(|(id, basis, k, p)| law_check(id, basis, k, p, tau0, l0, &ls, &req))
             .collect();
-        let fraction = ls
-            .iter()
-            .map(|&l| {
-                let f0 = actuator.mass_kg? / m0;
-                Some(match bridge {
-                    Bridge::IsometricActuator => f0 * (l / l0).powf(3.0) * m0 / design_mass_at(l),
-                    Bridge::FixedMassFraction => f0,
-                })
-            })
-            .collect();
+        let fraction = actuator_mass_fractions(bridge, actuator, (l0, m0), &ls, design_mass_at);
         bridges.push(BridgeCheck {
             bridge,
             description: format!("{} (here e = {e})", bridge.describe()),
@@ -241,6 +201,77 @@ pub fn torque_check(
         actuator_fit_n: n_fit,
         bridges,
     })
+}
+
+/// The anchor actuator's stall torque at `voltage` (None: its recommended voltage); an
+/// error when it has no rating there.
+fn anchor_stall_torque(actuator: &Actuator, voltage: Option<f64>) -> Result<f64, StudyError> {
+    actuator
+        .stall_torque_at(voltage)
+        .ok_or_else(|| StudyError::InvalidOption {
+            option: "voltage".into(),
+            reason: format!(
+                "actuator `{}` has no rating at {}",
+                actuator.id,
+                voltage
+                    .map(|v| format!("{v} V"))
+                    .unwrap_or("its recommended voltage".into())
+            ),
+        })
+}
+
+/// Every law of the catalogue as (id, basis, exponent in its own size variable, exponent
+/// p vs leg length under `bridge`), then the catalogue's own τ_stall ∝ M^b fit when there
+/// is one; `e` is the robot's mass-law exponent.
+fn laws_under(
+    bridge: Bridge,
+    catalogue: &MotorCatalogue,
+    fit: Option<&PowerLawFit>,
+    e: f64,
+) -> Vec<(String, String, f64, f64)> {
+    let mut laws: Vec<(String, String, f64, f64)> = catalogue
+        .laws
+        .iter()
+        .map(|law| {
+            let k = law.exponent;
+            let p = bridge_exponent(bridge, law.size_variable, law.quantity, k, e);
+            (
+                law.id.clone(),
+                format!("{:?}", law.basis).to_lowercase(),
+                k,
+                p,
+            )
+        })
+        .collect();
+    if let Some(f) = fit {
+        let p = match bridge {
+            Bridge::IsometricActuator => 3.0 * f.b,
+            Bridge::FixedMassFraction => e * f.b,
+        };
+        laws.push(("catalogue-fit".into(), "catalogue".into(), f.b, p));
+    }
+    laws
+}
+
+/// Actuator mass / robot mass at each leg length in `ls`, starting from the anchor's ratio
+/// at (leg length, robot mass) `(l0, m0)` and carried by `bridge`; None without an
+/// actuator mass.
+fn actuator_mass_fractions(
+    bridge: Bridge,
+    actuator: &Actuator,
+    (l0, m0): (f64, f64),
+    ls: &[f64],
+    design_mass_at: &dyn Fn(f64) -> f64,
+) -> Vec<Option<f64>> {
+    ls.iter()
+        .map(|&l| {
+            let f0 = actuator.mass_kg? / m0;
+            Some(match bridge {
+                Bridge::IsometricActuator => f0 * (l / l0).powf(3.0) * m0 / design_mass_at(l),
+                Bridge::FixedMassFraction => f0,
+            })
+        })
+        .collect()
 }
 
 /// The actuator, voltage and leg length the laws are pinned at: the one named, else the

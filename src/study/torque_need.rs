@@ -134,55 +134,11 @@ pub fn torque_need(
     let lo =
         interp(|p| p.bracket_lo_nm.map(|v| v / p.mgl_nm).filter(|v| *v > 0.0)).unwrap_or(ratio);
     let hi = interp(|p| p.bracket_hi_nm.map(|v| v / p.mgl_nm)).unwrap_or(ratio);
-    let gl = GRAVITY_MPS2 * leg_length_m;
-    let torques: Vec<TorqueAtMass> = masses
-        .iter()
-        .map(|(label, m, iv)| {
-            let [m_lo, m_hi] = iv.unwrap_or([*m, *m]);
-            TorqueAtMass {
-                mass_from: label.clone(),
-                mass_kg: *m,
-                mass_interval_kg: *iv,
-                required_nm: ratio * m * gl,
-                required_interval_nm: [lo.min(ratio) * m_lo * gl, hi.max(ratio) * m_hi * gl],
-            }
-        })
-        .collect();
-    let mut actuators = Vec::new();
-    if let (Some(cat), Some(need)) = (catalogue, torques.first()) {
-        let all: Vec<ActuatorOption> = cat
-            .actuators
-            .iter()
-            .filter_map(|a| {
-                let r = a.rating(None)?;
-                let margin = r.stall_torque_nm / need.required_nm;
-                Some(ActuatorOption {
-                    id: a.id.clone(),
-                    name: a.name.clone(),
-                    mass_kg: a.mass_kg,
-                    voltage_v: r.voltage_v,
-                    stall_torque_nm: r.stall_torque_nm,
-                    continuous_torque_nm: a.continuous_torque_nm,
-                    margin,
-                    meets_margin: margin >= torque_margin,
-                })
-            })
-            .collect();
-        actuators = all.iter().filter(|a| a.meets_margin).cloned().collect();
-        actuators.sort_by(|a, b| {
-            a.mass_kg
-                .unwrap_or(f64::INFINITY)
-                .total_cmp(&b.mass_kg.unwrap_or(f64::INFINITY))
-                .then(a.stall_torque_nm.total_cmp(&b.stall_torque_nm))
-        });
-        if actuators.is_empty() {
-            // None is strong enough: show the strongest, so the shortfall is visible.
-            let mut strongest = all;
-            strongest.sort_by(|a, b| b.stall_torque_nm.total_cmp(&a.stall_torque_nm));
-            strongest.truncate(3);
-            actuators = strongest;
-        }
-    }
+    let torques = required_torques(masses, leg_length_m, ratio, [lo, hi]);
+    let actuators = match (catalogue, torques.first()) {
+        (Some(cat), Some(need)) => actuator_options(cat, need.required_nm, torque_margin),
+        _ => Vec::new(),
+    };
     Ok(TorqueNeed {
         design: design.to_string(),
         leg_length_m,
@@ -195,4 +151,72 @@ pub fn torque_need(
         torque_margin,
         actuators,
     })
+}
+
+/// The torque each candidate mass needs at leg length L: τ_min/(m·g·L) times m·g·L, with a
+/// bracket that spans both the ratio's bracket `[lo, hi]` and the mass's own interval.
+fn required_torques(
+    masses: &[(String, f64, Option<[f64; 2]>)],
+    leg_length_m: f64,
+    ratio: f64,
+    [lo, hi]: [f64; 2],
+) -> Vec<TorqueAtMass> {
+    let gl = GRAVITY_MPS2 * leg_length_m;
+    masses
+        .iter()
+        .map(|(label, m, iv)| {
+            let [m_lo, m_hi] = iv.unwrap_or([*m, *m]);
+            TorqueAtMass {
+                mass_from: label.clone(),
+                mass_kg: *m,
+                mass_interval_kg: *iv,
+                required_nm: ratio * m * gl,
+                required_interval_nm: [lo.min(ratio) * m_lo * gl, hi.max(ratio) * m_hi * gl],
+            }
+        })
+        .collect()
+}
+
+/// The catalogued actuators whose stall torque (at the recommended voltage, or the only
+/// rating) is at least `torque_margin` × `required_nm`, lightest first; when none is, the
+/// three strongest, so the shortfall shows.
+fn actuator_options(
+    cat: &MotorCatalogue,
+    required_nm: f64,
+    torque_margin: f64,
+) -> Vec<ActuatorOption> {
+    let all: Vec<ActuatorOption> = cat
+        .actuators
+        .iter()
+        .filter_map(|a| {
+            let r = a.rating(None)?;
+            let margin = r.stall_torque_nm / required_nm;
+            Some(ActuatorOption {
+                id: a.id.clone(),
+                name: a.name.clone(),
+                mass_kg: a.mass_kg,
+                voltage_v: r.voltage_v,
+                stall_torque_nm: r.stall_torque_nm,
+                continuous_torque_nm: a.continuous_torque_nm,
+                margin,
+                meets_margin: margin >= torque_margin,
+            })
+        })
+        .collect();
+    let mut actuators: Vec<ActuatorOption> =
+        all.iter().filter(|a| a.meets_margin).cloned().collect();
+    actuators.sort_by(|a, b| {
+        a.mass_kg
+            .unwrap_or(f64::INFINITY)
+            .total_cmp(&b.mass_kg.unwrap_or(f64::INFINITY))
+            .then(a.stall_torque_nm.total_cmp(&b.stall_torque_nm))
+    });
+    if actuators.is_empty() {
+        // None is strong enough: show the strongest, so the shortfall is visible.
+        let mut strongest = all;
+        strongest.sort_by(|a, b| b.stall_torque_nm.total_cmp(&a.stall_torque_nm));
+        strongest.truncate(3);
+        actuators = strongest;
+    }
+    actuators
 }
