@@ -388,7 +388,7 @@ fn merge_kind<R: sweep::SweepPoint + PartialEq>(
 #[command(after_help = "Examples:
   survey torque-check --design mugatu
   survey torque-check --design mugatu --mass-law l3 --format json --plot torque-check.svg
-  survey torque-check --design zippy --actuator pololu-micro-metal-lp-6v-297 --voltage 6
+  survey torque-check --design zippy --actuator pololu-micro-metal-lp-6v-298 --voltage 6
 
 The required torque is Table III's minimum torque (the bundled reports/table3.points.csv, or \\
 --points FILE from `survey sim table3`). The motor laws (dataset/motors/laws.toml) have no \\

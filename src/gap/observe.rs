@@ -132,7 +132,7 @@ fn fill_one(
     let report =
         crate::sim::report_from_trajectory(&d, &crate::sim::WalkOptions::default(), &samples)
             .map_err(|e| format!("trajectory {}: {e}", path.display()))?;
-    for m in Metric::SIMULATED {
+    for m in Metric::simulated() {
         let v = m.of_report(&report);
         if t.measured(m).is_none() && v.is_finite() {
             t.measured[m.index()] = Some(Measurement { value: v, sd: None });

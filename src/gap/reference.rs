@@ -168,7 +168,7 @@ fn carry_trial(
     out.trajectory = None;
     out.measured = [None; 8];
     let mut n = 0;
-    for m in Metric::SIMULATED {
+    for m in Metric::simulated() {
         let Some(tm) = t.measured(m) else { continue };
         let nominal_value = nom.get(m);
         let Some(rm) = r.measured(m).filter(|_| nominal_value.is_finite()) else {

@@ -88,7 +88,7 @@ impl SimMetrics {
     /// as the truth): NaN where it measured nothing; a trial with no measured metric fell.
     pub fn measured_by(t: &Trial) -> SimMetrics {
         let mut values = [f64::NAN; 8];
-        for m in Metric::SIMULATED {
+        for m in Metric::simulated() {
             if let Some(v) = t.measured(m) {
                 values[m.index()] = v.value;
             }
@@ -328,7 +328,7 @@ impl Condition {
         let fell = r.report.fall_reason.is_some();
         let mut values = [f64::NAN; 8];
         if !fell {
-            for m in Metric::SIMULATED {
+            for m in Metric::simulated() {
                 values[m.index()] = m.of_report(&r.report);
             }
             if self.direction_free() {

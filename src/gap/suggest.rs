@@ -275,7 +275,7 @@ pub fn expected_entropy(
             .map(|w| w.max(f64::MIN_POSITIVE).ln())
             .collect();
         for &c in chosen {
-            for m in Metric::SIMULATED {
+            for m in Metric::simulated() {
                 let mu = walks[c][truth].get(m);
                 if !mu.is_finite() || mu == 0.0 {
                     continue;

@@ -124,7 +124,7 @@ fn measured(
     for (t, m) in conditions.iter().zip(truth) {
         let mut t = t.clone();
         t.measured = [None; 8];
-        for metric in Metric::SIMULATED {
+        for metric in Metric::simulated() {
             let v = m.get(metric);
             // Draw even for a missing value, so one trial's fall does not shift the noise of
             // the others.

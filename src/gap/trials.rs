@@ -34,15 +34,11 @@ impl Metric {
         Metric::Cot,
     ];
     /// The metrics one walk gives (the minimum torque needs a bisection of walks).
-    pub const SIMULATED: [Metric; 7] = [
-        Metric::VelocityMps,
-        Metric::StepFrequencyHz,
-        Metric::RollPpDeg,
-        Metric::PitchPpDeg,
-        Metric::YawPpDeg,
-        Metric::PeakTorqueNm,
-        Metric::Cot,
-    ];
+    pub fn simulated() -> impl Iterator<Item = Metric> {
+        Metric::ALL
+            .into_iter()
+            .filter(|m| *m != Metric::MinTorqueNm)
+    }
     pub fn column(self) -> &'static str {
         match self {
             Metric::VelocityMps => "velocity_mps",

@@ -12,6 +12,7 @@
 //!   points.
 //! - [`bootstrap_line`]: seeded case-resampling percentile intervals.
 //! - [`predict_ols`], [`back_transform`], [`inverse_predict_ols`]: prediction.
+//! - [`spearman`]: rank correlation.
 //!
 //! This module depends only on external crates, never on other `crate::` modules.
 #![warn(missing_docs)]
@@ -25,6 +26,7 @@ mod line;
 mod moments;
 mod power_law;
 mod predict;
+mod rank;
 
 pub use bootstrap::{
     BcaInterval, BootstrapConfig, BootstrapResult, bca_interval, bootstrap_line,
@@ -45,3 +47,4 @@ pub use predict::{
     BackTransformedPrediction, BiasCorrection, CentreKind, InversePrediction, OlsPrediction,
     back_transform, inverse_predict_ols, predict_ols, predict_power_law,
 };
+pub use rank::spearman;

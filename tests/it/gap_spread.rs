@@ -56,7 +56,7 @@ fn the_model_spread_is_the_sd_of_walks_from_perturbed_starts() {
         .collect();
     assert!(runs.iter().all(|r| r.fall_reason.is_none()), "Zippy walks");
     let mut some_spread = false;
-    for m in Metric::SIMULATED {
+    for m in Metric::simulated() {
         let v: Vec<f64> = runs.iter().map(|r| m.of_report(r)).collect();
         let mean = v.iter().sum::<f64>() / 4.0;
         let sd = (v.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / 3.0).sqrt();

@@ -1,6 +1,7 @@
 //! Unit tests of `gap::explore`.
 
-use robot_survey::gap::explore::{latin_hypercube, spearman};
+use robot_survey::gap::explore::latin_hypercube;
+use robot_survey::regression::spearman;
 
 #[test]
 fn latin_hypercube_fills_every_stratum_once() {
