@@ -69,6 +69,8 @@ pub struct Weighed {
     pub walked_chi2: Option<f64>,
     /// The observations with the model's own spread at the mode (None: the nominal's).
     pub obs: Option<Vec<Observation>>,
+    /// A confirmed pair's corrected surrogate's error per observation, from walks it had not seen.
+    pub surrogate_sd: Option<Vec<f64>>,
     /// ln of the Bayes factor of this explanation with "something outside these" beside it
     /// over it alone, at its most probable point.
     pub log_bf: f64,
@@ -192,6 +194,7 @@ impl State {
                 walks: None,
                 walked_chi2: None,
                 obs: None,
+                surrogate_sd: None,
                 log_bf: f64::NEG_INFINITY,
                 probability: 0.0,
                 share: 0.0,
@@ -252,6 +255,11 @@ impl State {
         )?;
         let mut obs = inp.obs.to_vec();
         super::discrepancy::apply(&mut obs, &spread);
+        if let Some(sd) = &w.surrogate_sd {
+            for (o, s) in obs.iter_mut().zip(sd) {
+                o.model_sd = o.model_sd.hypot(*s);
+            }
+        }
         let log_norm = log_normaliser(&obs);
         let e = self.integrate_on(inp, &obs, log_norm, &free, w.correction.as_ref());
         let w = &mut self.weighed[i];
@@ -468,10 +476,13 @@ fn anchor(
 }
 
 /// Confirms pair `i`: walks at its mode and one posterior width along each knob give a
-/// first-order correction; integrate again with it; repeat while the mode moves.
+/// first-order correction; integrate again with it; repeat while the mode moves; walk the
+/// last mode. Each walk at a mode a correction had not seen measures its error, which the
+/// likelihood counts beside the model's spread (a knife-edge gait defeats local corrections).
 fn confirm_pair(inp: &Inputs<'_>, st: &mut State, i: usize, rounds: usize) -> Result<(), GapError> {
     let free = st.weighed[i].hypothesis.knobs.clone();
-    for _ in 0..rounds {
+    let (mut misses, mut settled) = (Vec::new(), false);
+    for round in 0..=rounds {
         let e = &st.weighed[i].evidence;
         if e.mode.iter().any(|v| !v.is_finite()) {
             break;
@@ -479,8 +490,16 @@ fn confirm_pair(inp: &Inputs<'_>, st: &mut State, i: usize, rounds: usize) -> Re
         let (u, w) = (e.mode.clone(), widths(e));
         let set = inp.knobs.set_of(&free, &u);
         let walks = inp.walks(&set)?;
-        let mut stepped = Vec::new();
-        let mut steps = Vec::new();
+        if let Some(c) = &st.weighed[i].correction {
+            misses.push(surrogate_misses(inp, &st.surrogate, &set, c, &walks));
+        }
+        let wt = &mut st.weighed[i];
+        wt.walked_chi2 = Some(chi2_of(inp.obs, &walks));
+        if settled || round == rounds {
+            wt.walks = Some(walks);
+            break;
+        }
+        let (mut stepped, mut steps) = (Vec::new(), Vec::new());
         for j in 0..free.len() {
             let dir = if u[j] + w[j] <= 1.0 { 1.0 } else { -1.0 };
             let mut moved = u.clone();
@@ -499,15 +518,39 @@ fn confirm_pair(inp: &Inputs<'_>, st: &mut State, i: usize, rounds: usize) -> Re
             .map(|((a, b), w)| (a - b).abs() / w)
             .fold(0.0, f64::max);
         let wt = &mut st.weighed[i];
-        wt.walked_chi2 = Some(chi2_of(inp.obs, &walks));
         wt.walks = Some(walks);
         wt.evidence = fresh;
         wt.correction = Some(c);
-        if moved.is_nan() || moved <= 0.25 {
-            break;
-        }
+        settled = moved.is_nan() || moved <= 0.25;
     }
+    st.weighed[i].surrogate_sd = surrogate_sd(&misses);
     Ok(())
+}
+
+/// Walked minus predicted (the surrogate with correction `c`) at `set`, per observation.
+fn surrogate_misses(
+    inp: &Inputs<'_>,
+    s: &Surrogate,
+    set: &[(usize, f64)],
+    c: &Correction,
+    walks: &[Walked],
+) -> Vec<f64> {
+    let miss = |o: &Observation| {
+        walks[o.trial].channel(o.channel) - s.predict(o.trial, o.channel, set, Some(c))
+    };
+    inp.obs.iter().map(miss).collect()
+}
+
+/// Each observation's root-mean-square miss over the walks where it is one (None: no walk).
+pub fn surrogate_sd(misses: &[Vec<f64>]) -> Option<Vec<f64>> {
+    let rms = |o: usize| {
+        let (mut sum, mut n) = (0.0, 0);
+        for x in misses.iter().map(|v| v[o]).filter(|x| x.is_finite()) {
+            (sum, n) = (sum + x * x, n + 1);
+        }
+        (sum / n.max(1) as f64).sqrt()
+    };
+    Some((0..misses.first()?.len()).map(rms).collect())
 }
 
 /// Weighs `hypotheses` (the nominal and "something outside these" among them) on

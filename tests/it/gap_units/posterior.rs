@@ -1,9 +1,10 @@
 //! Unit tests of `gap::posterior`: the normalisation of priors, evidences and Bayes factors
-//! into probabilities, against values derived by hand.
+//! into probabilities, and the surrogate's error of a confirmed pair, against values derived
+//! by hand.
 
 use robot_survey::gap::evidence::Evidence;
 use robot_survey::gap::hypothesis::{Class, Hypothesis};
-use robot_survey::gap::posterior::{Weighed, normalise};
+use robot_survey::gap::posterior::{Weighed, normalise, surrogate_sd};
 
 fn weighed(knobs: Vec<usize>, class: Class, prior: f64, log_z: f64, log_bf: f64) -> Weighed {
     let mut evidence = Evidence::empty(knobs.len());
@@ -18,6 +19,7 @@ fn weighed(knobs: Vec<usize>, class: Class, prior: f64, log_z: f64, log_bf: f64)
         correction: None,
         walks: None,
         walked_chi2: None,
+        surrogate_sd: None,
         obs: None,
         log_bf,
         probability: 0.0,
@@ -76,4 +78,15 @@ fn explanations_rank_by_their_share_when_outside_takes_everything() {
     let r = 2.0 * (-1.0f64).exp();
     assert!((w[0].share - 1.0 / (1.0 + r)).abs() < 1e-12);
     assert!((w[1].share - r / (1.0 + r)).abs() < 1e-12);
+}
+
+/// The surrogate's error per observation is the root-mean-square of its finite misses over
+/// the walks it had not seen: misses (1, −1) → 1; (NaN, 2) → 2; (3, NaN) → 3; none finite
+/// → 0; and no walk at all measures nothing.
+#[test]
+fn surrogate_error_is_the_rms_of_finite_misses() {
+    let nan = f64::NAN;
+    let misses = vec![vec![1.0, nan, 3.0, nan], vec![-1.0, 2.0, nan, nan]];
+    assert_eq!(surrogate_sd(&misses), Some(vec![1.0, 2.0, 3.0, 0.0]));
+    assert_eq!(surrogate_sd(&[]), None);
 }
