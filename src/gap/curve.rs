@@ -97,15 +97,19 @@ impl Curve {
         curve
     }
 
-    /// Adds a node (ignored if one already sits within 1e-12).
+    /// Adds a node (ignored if one already sits within 1e-12: `has_node`).
     pub fn insert(&mut self, x: f64, walks: &[Walked]) {
         if self.add(x, walks) {
             self.update_slopes();
         }
     }
 
+    pub fn has_node(&self, x: f64) -> bool {
+        self.x.iter().any(|v| (v - x).abs() < 1e-12)
+    }
+
     fn add(&mut self, x: f64, walks: &[Walked]) -> bool {
-        if self.x.iter().any(|v| (v - x).abs() < 1e-12) {
+        if self.has_node(x) {
             return false;
         }
         let k = self.x.partition_point(|v| *v < x);
@@ -119,10 +123,8 @@ impl Curve {
     }
 
     fn update_slopes(&mut self) {
-        for per_channel in self.series.iter_mut() {
-            for s in per_channel.iter_mut() {
-                s.1 = pchip_slopes(&self.x, &s.0);
-            }
+        for s in self.series.iter_mut().flatten() {
+            s.1 = pchip_slopes(&self.x, &s.0);
         }
     }
 

@@ -46,8 +46,8 @@ pub struct Observation {
     /// The measurement's sd.
     pub sd: f64,
     pub sd_assumed: bool,
-    /// The model's own spread at this condition and channel (with, for a pair, its
-    /// surrogate's error there).
+    /// The model's own spread at this condition and channel (with, for a refined
+    /// explanation, its surrogate's error there).
     pub model_sd: f64,
 }
 

@@ -69,7 +69,7 @@ pub struct Weighed {
     pub walked_chi2: Option<f64>,
     /// The observations with the model's own spread at the mode (None: the nominal's).
     pub obs: Option<Vec<Observation>>,
-    /// A confirmed pair's corrected surrogate's error per observation, from walks it had not seen.
+    /// The surrogate's error per observation near the mode, from walks it had not seen.
     pub surrogate_sd: Option<Vec<f64>>,
     /// ln of the Bayes factor of this explanation with "something outside these" beside it
     /// over it alone, at its most probable point.
@@ -139,15 +139,9 @@ impl State {
     }
 
     /// An explanation's predictions at its most probable point on the surrogate (and walks'
-    /// correction) its evidence integrates, so that its Bayes factor compares like with like.
+    /// correction) its evidence integrates, so that its Bayes factor compares like with like
+    /// (the nominal's: the surrogate's nominal walks, non-finite where they fall).
     fn predictions(&self, inp: &Inputs<'_>, w: &Weighed) -> Vec<f64> {
-        if w.hypothesis.knobs.is_empty() {
-            return inp
-                .obs
-                .iter()
-                .map(|o| self.surrogate.nominal[o.trial].channel(o.channel))
-                .collect();
-        }
         if w.evidence.mode.iter().any(|v| !v.is_finite()) {
             return vec![f64::NAN; inp.obs.len()];
         }
@@ -386,7 +380,8 @@ fn widths(e: &Evidence) -> Vec<f64> {
 
 /// Refines single explanation `i`: walks at its mode and a posterior width either side
 /// become nodes of its knob's curve; integrate again; repeat while the mode moves by more than
-/// a quarter of the posterior's width.
+/// a quarter of the posterior's width. Each walk between nodes already placed about the mode
+/// measures the curve's error there, which the likelihood counts as for a pair.
 fn refine_single(
     inp: &Inputs<'_>,
     st: &mut State,
@@ -395,28 +390,30 @@ fn refine_single(
 ) -> Result<(), GapError> {
     let k = st.weighed[i].hypothesis.knobs[0];
     let knob = &inp.knobs.list[k];
+    let mut misses = Vec::new();
+    let mut node = |st: &mut State, x: f64, judge: bool| -> Result<Vec<Walked>, GapError> {
+        let (walks, set) = (inp.walks(&[(k, x)])?, [(k, x)]);
+        if judge && !st.surrogate.curves[k].has_node(x) {
+            misses.push(surrogate_misses(inp, &st.surrogate, &set, None, &walks));
+        }
+        st.surrogate.curves[k].insert(x, &walks);
+        Ok(walks)
+    };
     for round in 0..rounds {
         let e = &st.weighed[i].evidence;
         let (u, w) = (e.mode[0], widths(e)[0]);
         if !u.is_finite() {
             break;
         }
-        let sides: &[f64] = if round == 0 {
-            &[0.0, -1.0, 1.0]
-        } else {
-            &[-1.0, 1.0]
-        };
-        for side in sides {
+        // The mode itself in the first round; each round walks its new mode at its end.
+        for side in &[0.0, -1.0, 1.0][(round > 0) as usize..] {
             let x = knob.from_unit((u + side * w).clamp(0.0, 1.0));
-            let walks = inp.walks(&[(k, x)])?;
-            st.surrogate.curves[k].insert(x, &walks);
+            node(st, x, round > 0)?;
         }
         st.slabs[k] = Slab::new(k, knob, &st.surrogate, inp.obs);
         let fresh = st.integrate(inp, &[k], None);
         let moved = (fresh.mode[0] - u).abs();
-        let x = knob.from_unit(fresh.mode[0]);
-        let walks = inp.walks(&[(k, x)])?;
-        st.surrogate.curves[k].insert(x, &walks);
+        let walks = node(st, knob.from_unit(fresh.mode[0]), true)?;
         let w = &mut st.weighed[i];
         w.walked_chi2 = Some(chi2_of(inp.obs, &walks));
         w.walks = Some(walks);
@@ -427,6 +424,7 @@ fn refine_single(
     }
     st.slabs[k] = Slab::new(k, knob, &st.surrogate, inp.obs);
     st.weighed[i].evidence = st.integrate(inp, &[k], None);
+    st.weighed[i].surrogate_sd = surrogate_sd(&misses);
     Ok(())
 }
 
@@ -491,7 +489,7 @@ fn confirm_pair(inp: &Inputs<'_>, st: &mut State, i: usize, rounds: usize) -> Re
         let set = inp.knobs.set_of(&free, &u);
         let walks = inp.walks(&set)?;
         if let Some(c) = &st.weighed[i].correction {
-            misses.push(surrogate_misses(inp, &st.surrogate, &set, c, &walks));
+            misses.push(surrogate_misses(inp, &st.surrogate, &set, Some(c), &walks));
         }
         let wt = &mut st.weighed[i];
         wt.walked_chi2 = Some(chi2_of(inp.obs, &walks));
@@ -532,12 +530,11 @@ fn surrogate_misses(
     inp: &Inputs<'_>,
     s: &Surrogate,
     set: &[(usize, f64)],
-    c: &Correction,
+    c: Option<&Correction>,
     walks: &[Walked],
 ) -> Vec<f64> {
-    let miss = |o: &Observation| {
-        walks[o.trial].channel(o.channel) - s.predict(o.trial, o.channel, set, Some(c))
-    };
+    let miss =
+        |o: &Observation| walks[o.trial].channel(o.channel) - s.predict(o.trial, o.channel, set, c);
     inp.obs.iter().map(miss).collect()
 }
 
@@ -632,13 +629,11 @@ fn walk_leaders(
 /// confirms a pair.
 fn walk_one(inp: &Inputs<'_>, st: &mut State, i: usize, rounds: usize) -> Result<(), GapError> {
     let key = st.weighed[i].hypothesis.knobs.clone();
-    match key.len() {
-        1 => {
-            refine_single(inp, st, i, rounds)?;
-            st.reintegrate(inp, &key);
-        }
-        2 => confirm_pair(inp, st, i, rounds)?,
-        _ => {}
+    if key.len() == 1 {
+        refine_single(inp, st, i, rounds)?;
+        st.reintegrate(inp, &key);
+    } else if key.len() == 2 {
+        confirm_pair(inp, st, i, rounds)?;
     }
     Ok(())
 }
@@ -667,9 +662,7 @@ fn spread_at_walked_modes(inp: &Inputs<'_>, st: &mut State) -> Result<(), GapErr
             w.walks.is_some() && !w.hypothesis.knobs.is_empty() && w.obs.is_none()
         })
         .collect();
-    for &i in &todo {
-        st.spread_at_mode(inp, i)?;
-    }
+    todo.iter().try_for_each(|&i| st.spread_at_mode(inp, i))?;
     if !todo.is_empty() {
         st.normalise(inp);
     }
@@ -681,9 +674,9 @@ fn spread_at_walked_modes(inp: &Inputs<'_>, st: &mut State) -> Result<(), GapErr
 /// confirmed: the answer always rests on real walks at its most probable point.
 fn walk_the_top(inp: &Inputs<'_>, st: &mut State, search: &Search) -> Result<(), GapError> {
     for _ in 0..PASSES {
-        match st.weighed.first() {
-            Some(top) if top.walks.is_none() && (1..=2).contains(&top.hypothesis.knobs.len()) => {}
-            _ => break,
+        let top = st.weighed.first();
+        if !top.is_some_and(|t| t.walks.is_none() && (1..=2).contains(&t.hypothesis.knobs.len())) {
+            break;
         }
         walk_one(inp, st, 0, search.rounds)?;
         st.normalise(inp);
@@ -695,16 +688,12 @@ fn walk_the_top(inp: &Inputs<'_>, st: &mut State, search: &Search) -> Result<(),
 /// Pairs are worth the walks when no explanation yet reaches the threshold, or the most
 /// probable one does not fit.
 fn needs_pairs(st: &State, decision: &Decision) -> bool {
-    let top = st.weighed.first();
     let outside = st.outside.as_ref().map_or(0.0, |o| o.2);
-    match top {
-        Some(w) => {
-            w.evidence.fit_p < decision.fit_level
-                || w.probability.max(outside) < decision.threshold
-                || outside >= decision.threshold
-        }
-        None => false,
-    }
+    st.weighed.first().is_some_and(|w| {
+        w.evidence.fit_p < decision.fit_level
+            || w.probability.max(outside) < decision.threshold
+            || outside >= decision.threshold
+    })
 }
 
 /// Anchors the surrogate at the most probable refined single explanation's mode, and

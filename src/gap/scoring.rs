@@ -40,10 +40,8 @@ pub fn leading(r: &CaseRow) -> Vec<(String, f64)> {
 fn intervals_of(s: &str) -> BTreeMap<String, String> {
     split(s)
         .iter()
-        .filter_map(|iv| {
-            let (k, r) = iv.split_once('=')?;
-            Some((k.to_string(), r.to_string()))
-        })
+        .filter_map(|iv| iv.split_once('='))
+        .map(|(k, r)| (k.to_string(), r.to_string()))
         .collect()
 }
 

@@ -102,6 +102,36 @@ fn one_knob_evidence_is_the_gaussian_integral() {
     );
 }
 
+/// One linear knob, y ~ N(10x, 1) measured 10.5: the likelihood peaks beyond the range, so the
+/// posterior rises all the way to x = 1. By hand its 95 % highest-density interval is [x₀, 1]
+/// with Φ(10x₀ − 10.5) = 0.05 Φ(−0.5) (the slab's hole at x < 51/512 holds ~1e-19 of it):
+/// x₀ = 0.8341 — it holds the mode, where the equal-tailed interval [0.8078, 0.9978] would not.
+#[test]
+fn interval_at_a_range_end_holds_the_mode() {
+    let (knobs, sur) = linear(&[10.0]);
+    let obs = [Observation::metric(
+        0,
+        Metric::VelocityMps,
+        10.5,
+        1.0,
+        false,
+    )];
+    let slabs = [Slab::new(0, &knobs.list[0], &sur, &obs)];
+    let t = Target {
+        surrogate: &sur,
+        knobs: &knobs,
+        obs: &obs,
+        free: &[0],
+        slabs: &slabs,
+        correction: None,
+        log_norm: log_normaliser(&obs),
+    };
+    let e = evidence(&t, 0);
+    let [lo, hi] = e.intervals[0];
+    assert!((lo - 0.8341).abs() < 0.003, "{:?}", e.intervals);
+    assert!(hi > 0.998 && (lo..=hi).contains(&e.mode[0]), "{e:?}");
+}
+
 /// Two linear knobs, two observations y₁ ~ N(10a, 1) = 4 and y₂ ~ N(10a + 10b, 1) = 9: the
 /// posterior is Gaussian at (0.4, 0.5) with precision [[200, 100], [100, 100]]. The
 /// importance sampler's ln Z matches a 1000 × 1000 midpoint grid of the same target to
