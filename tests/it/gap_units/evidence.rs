@@ -1,7 +1,7 @@
 //! Unit tests of `gap::evidence`.
 
 use robot_survey::gap::curve::Curve;
-use robot_survey::gap::evidence::{Slab, Target, evidence};
+use robot_survey::gap::evidence::{Evidence, Slab, Target, evidence};
 use robot_survey::gap::knob::{Knob, KnobKind, Knobs};
 use robot_survey::gap::likelihood::{Observation, log_normaliser};
 use robot_survey::gap::simulate::{SimMetrics, Walked};
@@ -63,15 +63,10 @@ fn linear(slopes: &[f64]) -> (Knobs, Surrogate) {
     )
 }
 
-/// One linear knob, one observation y ~ N(10x, 1), measured 5, uniform prior on [0, 1]
-/// less the slab's hole |10x| < 1 (resolved to the cell: x ≥ 51/512): by hand,
-/// Z = ∫ φ(10x − 5) dx / (1 − 51/512) = [Φ(5) − Φ(−4.98)] / 10 / (1 − 51/512). The
-/// quadrature matches to 1e-6; the mode is 0.5, the 95 % interval 0.5 ± 0.196 and
-/// Laplace's value 0.1 / (1 − 51/512) (a Gaussian, far from the ends).
-#[test]
-fn one_knob_evidence_is_the_gaussian_integral() {
+/// The evidence of one linear knob y = 10x (nominal 0) from y measured at `y` with sd 1.
+fn one_linear_knob(y: f64) -> Evidence {
     let (knobs, sur) = linear(&[10.0]);
-    let obs = [Observation::metric(0, Metric::VelocityMps, 5.0, 1.0, false)];
+    let obs = [Observation::metric(0, Metric::VelocityMps, y, 1.0, false)];
     let slabs = [Slab::new(0, &knobs.list[0], &sur, &obs)];
     let t = Target {
         surrogate: &sur,
@@ -82,7 +77,17 @@ fn one_knob_evidence_is_the_gaussian_integral() {
         correction: None,
         log_norm: log_normaliser(&obs),
     };
-    let e = evidence(&t, 0);
+    evidence(&t, 0)
+}
+
+/// One linear knob, one observation y ~ N(10x, 1), measured 5, uniform prior on [0, 1]
+/// less the slab's hole |10x| < 1 (resolved to the cell: x ≥ 51/512): by hand,
+/// Z = ∫ φ(10x − 5) dx / (1 − 51/512) = [Φ(5) − Φ(−4.98)] / 10 / (1 − 51/512). The
+/// quadrature matches to 1e-6; the mode is 0.5, the 95 % interval 0.5 ± 0.196 and
+/// Laplace's value 0.1 / (1 − 51/512) (a Gaussian, far from the ends).
+#[test]
+fn one_knob_evidence_is_the_gaussian_integral() {
+    let e = one_linear_knob(5.0);
     let phi = |z: f64| robot_survey::regression::dist::normal_cdf(z).unwrap();
     let mass = 1.0 - 51.0 / 512.0;
     let want = ((phi(5.0) - phi(10.0 * 51.0 / 512.0 - 5.0)) / 10.0 / mass).ln();
@@ -108,25 +113,7 @@ fn one_knob_evidence_is_the_gaussian_integral() {
 /// x₀ = 0.8341 — it holds the mode, where the equal-tailed interval [0.8078, 0.9978] would not.
 #[test]
 fn interval_at_a_range_end_holds_the_mode() {
-    let (knobs, sur) = linear(&[10.0]);
-    let obs = [Observation::metric(
-        0,
-        Metric::VelocityMps,
-        10.5,
-        1.0,
-        false,
-    )];
-    let slabs = [Slab::new(0, &knobs.list[0], &sur, &obs)];
-    let t = Target {
-        surrogate: &sur,
-        knobs: &knobs,
-        obs: &obs,
-        free: &[0],
-        slabs: &slabs,
-        correction: None,
-        log_norm: log_normaliser(&obs),
-    };
-    let e = evidence(&t, 0);
+    let e = one_linear_knob(10.5);
     let [lo, hi] = e.intervals[0];
     assert!((lo - 0.8341).abs() < 0.003, "{:?}", e.intervals);
     assert!(hi > 0.998 && (lo..=hi).contains(&e.mode[0]), "{e:?}");
