@@ -232,8 +232,8 @@ impl Weighted {
     /// cell's lower edge to its last cell's upper edge (the most massive of equally short
     /// ones): the highest posterior density interval of a one-peaked marginal, holding its mode.
     fn shortest(&self, axis: usize) -> [f64; 2] {
-        let half = |p: &(Vec<f64>, f64, f64, f64)| (p.0[axis], p.1, p.3 / 2.0);
-        let mut v: Vec<(f64, f64, f64)> = self.points.iter().map(half).collect();
+        let on_axis = |p: &(Vec<f64>, f64, f64, f64)| (p.0[axis], p.1, p.3 / 2.0);
+        let mut v: Vec<(f64, f64, f64)> = self.points.iter().map(on_axis).collect();
         v.sort_by(|a, b| a.0.total_cmp(&b.0));
         let mut cum = vec![0.0];
         for p in &v {

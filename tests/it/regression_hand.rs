@@ -662,3 +662,14 @@ proptest! {
         }
     }
 }
+
+#[test]
+fn spearman_matches_hand_values() {
+    use robot_survey::regression::spearman;
+    // Monotone: +1 / −1 whatever the spacing.
+    assert!((spearman(&[1.0, 2.0, 3.0, 4.0], &[1.0, 10.0, 100.0, 1000.0]) - 1.0).abs() < 1e-12);
+    assert!((spearman(&[1.0, 2.0, 3.0, 4.0], &[4.0, 3.0, 1.0, 0.5]) + 1.0).abs() < 1e-12);
+    // Ranks x = 1..5, y = (2,1,4,3,5): Σd² = 4, ρ = 1 − 6·4/(5·24) = 0.8.
+    let r = spearman(&[1.0, 2.0, 3.0, 4.0, 5.0], &[2.0, 1.0, 4.0, 3.0, 5.0]);
+    assert!((r - 0.8).abs() < 1e-12, "{r}");
+}
