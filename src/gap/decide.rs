@@ -223,11 +223,7 @@ fn kind_of(w: &Weighed, knobs: &Knobs) -> AnswerKind {
 }
 
 fn pct(p: f64) -> String {
-    if p >= 0.995 {
-        format!("{:.3}", p)
-    } else {
-        format!("{:.2}", p)
-    }
+    format!("{:.*}", if p >= 0.995 { 3 } else { 2 }, p)
 }
 
 /// The answer in one sentence.

@@ -70,14 +70,11 @@ impl GapError {
 }
 
 /// Checks the relative sd assumed where a measurement states none.
-pub fn check_default_sd(default_relative_sd: f64) -> Result<(), GapError> {
-    if default_relative_sd > 0.0 && default_relative_sd.is_finite() {
-        Ok(())
-    } else {
-        Err(GapError::Invalid(
-            "the default relative sd must be finite and > 0".into(),
-        ))
-    }
+pub fn check_default_sd(sd: f64) -> Result<(), GapError> {
+    let message = "the default relative sd must be finite and > 0";
+    (sd > 0.0 && sd.is_finite())
+        .then_some(())
+        .ok_or(GapError::Invalid(message.into()))
 }
 
 /// The text of the file at `path`.
@@ -87,9 +84,8 @@ pub fn read_text(path: &Path) -> Result<String, GapError> {
 
 /// `file:line:column: message`, the column left out when it is not known (0).
 fn at_line(path: &str, line: u64, column: usize, message: &str) -> String {
-    if column == 0 {
-        format!("{path}:{line}: {message}")
-    } else {
-        format!("{path}:{line}:{column}: {message}")
+    match column {
+        0 => format!("{path}:{line}: {message}"),
+        c => format!("{path}:{line}:{c}: {message}"),
     }
 }

@@ -167,8 +167,11 @@ pub struct Evidence {
     /// The most probable point (unit coordinates of the free knobs).
     pub mode: Vec<f64>,
     pub chi2_mode: f64,
-    /// 95 % highest-density credible interval of each free knob (unit coordinates).
+    /// 95 % credible interval of each free knob (unit coordinates): its range over the
+    /// highest-density region holding 95 % of the posterior, which holds the mode.
     pub intervals: Vec<[f64; 2]>,
+    /// 95 % highest-density interval of each knob's marginal: the search's scale.
+    pub marginal: Vec<[f64; 2]>,
     /// Posterior-predictive p-value of χ²: E over the posterior of P(χ²ₙ ≥ χ²(θ)).
     pub fit_p: f64,
     /// Effective number of points behind the integral.
@@ -194,6 +197,7 @@ impl Evidence {
             mode: vec![f64::NAN; d],
             chi2_mode: f64::NAN,
             intervals: vec![[f64::NAN; 2]; d],
+            marginal: vec![[f64::NAN; 2]; d],
             fit_p: 0.0,
             ess: 0.0,
         }
@@ -212,6 +216,7 @@ fn nominal(target: &Target<'_>) -> Evidence {
         mode: Vec::new(),
         chi2_mode: chi2,
         intervals: Vec::new(),
+        marginal: Vec::new(),
         fit_p: chi2_sf(chi2, target.obs.len()),
         ess: 1.0,
     }
@@ -338,6 +343,7 @@ fn one_knob(target: &Target<'_>) -> Evidence {
         chi2_mode: target.eval(&[mode]).1,
         mode: vec![mode],
         intervals: w.intervals(1),
+        marginal: w.intervals(1),
         fit_p: w.fit_p(target.obs.len()),
         ess: w.ess(),
     }
@@ -501,6 +507,7 @@ fn two_knobs(target: &Target<'_>, seed: u64) -> Evidence {
         let (u, l) = polish(target, &best.0, 1.0 / (4.0 * MODE_GRID as f64));
         (mode, l_mode) = ([u[0], u[1]], l);
     }
+    let intervals = region(&evaluated, top, &mode);
     let w = Weighted {
         points: evaluated
             .into_iter()
@@ -521,10 +528,32 @@ fn two_knobs(target: &Target<'_>, seed: u64) -> Evidence {
         log_z_laplace,
         chi2_mode: target.eval(&mode).1,
         mode: mode.to_vec(),
-        intervals: w.intervals(2),
+        intervals,
+        marginal: w.intervals(2),
         fit_p: w.fit_p(target.obs.len()),
         ess: w.ess(),
     }
+}
+
+/// Each knob's range over the 95 % highest-density region of importance samples (u, ln
+/// weight, χ², ln density): the densest samples holding 95 % of the weight, and the mode,
+/// which a marginal interval of a thin ridge can miss.
+fn region(samples: &[(Vec<f64>, f64, f64, f64)], top: f64, mode: &[f64]) -> Vec<[f64; 2]> {
+    let mut by_density: Vec<&(Vec<f64>, f64, f64, f64)> =
+        samples.iter().filter(|p| p.1.is_finite()).collect();
+    by_density.sort_by(|a, b| b.3.total_cmp(&a.3));
+    let need = 0.95 * by_density.iter().map(|p| (p.1 - top).exp()).sum::<f64>();
+    let (mut out, mut held) = (mode.iter().map(|m| [*m, *m]).collect::<Vec<_>>(), 0.0);
+    for p in by_density {
+        if held >= need {
+            break;
+        }
+        held += (p.1 - top).exp();
+        for (o, x) in out.iter_mut().zip(&p.0) {
+            *o = [o[0].min(*x), o[1].max(*x)];
+        }
+    }
+    out
 }
 
 fn det(c: &[[f64; 2]; 2]) -> f64 {
@@ -674,6 +703,7 @@ impl Discrepancy {
                 .into_iter()
                 .map(|[a, b]| [(lo + a * (hi - lo)).exp(), (lo + b * (hi - lo)).exp()])
                 .collect(),
+            marginal: w.intervals(1),
             fit_p: w.fit_p(obs.len()),
             ess: w.ess(),
         }

@@ -71,36 +71,23 @@ pub fn hypotheses(knobs: &Knobs, testable: &[bool], priors: &ClassPriors) -> Vec
     let undeclared: Vec<usize> = (0..knobs.len())
         .filter(|&k| testable[k] && knobs.list[k].kind == KnobKind::Undeclared)
         .collect();
-    let mut members: Vec<(Class, Vec<Vec<usize>>)> = vec![
-        (Class::Nominal, vec![Vec::new()]),
-        (Class::One, suspects.iter().map(|k| vec![*k]).collect()),
-        (
-            Class::Two,
-            suspects
-                .iter()
-                .enumerate()
-                .flat_map(|(i, a)| suspects[i + 1..].iter().map(move |b| vec![*a, *b]))
-                .collect(),
-        ),
-        (
-            Class::Undeclared,
-            undeclared.iter().map(|k| vec![*k]).collect(),
-        ),
-        (Class::NoneOfThese, vec![Vec::new()]),
+    let singles = |ks: &[usize]| ks.iter().map(|k| vec![*k]).collect::<Vec<_>>();
+    let two = (suspects.iter().enumerate())
+        .flat_map(|(i, a)| suspects[i + 1..].iter().map(move |b| vec![*a, *b]));
+    let p = priors;
+    let mut members: Vec<(Class, f64, Vec<Vec<usize>>)> = vec![
+        (Class::Nominal, p.nominal, vec![Vec::new()]),
+        (Class::One, p.one, singles(&suspects)),
+        (Class::Two, p.two, two.collect()),
+        (Class::Undeclared, p.undeclared, singles(&undeclared)),
+        (Class::NoneOfThese, p.none_of_these, vec![Vec::new()]),
     ];
-    members.retain(|(_, m)| !m.is_empty());
-    let mass = |c: Class| match c {
-        Class::Nominal => priors.nominal,
-        Class::One => priors.one,
-        Class::Two => priors.two,
-        Class::Undeclared => priors.undeclared,
-        Class::NoneOfThese => priors.none_of_these,
-    };
-    let total: f64 = members.iter().map(|(c, _)| mass(*c)).sum();
+    members.retain(|(_, _, m)| !m.is_empty());
+    let total: f64 = members.iter().map(|m| m.1).sum();
     members
         .into_iter()
-        .flat_map(|(class, sets)| {
-            let each = mass(class) / total / sets.len() as f64;
+        .flat_map(|(class, mass, sets)| {
+            let each = mass / total / sets.len() as f64;
             sets.into_iter().map(move |knobs| Hypothesis {
                 knobs,
                 class,

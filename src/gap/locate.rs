@@ -240,11 +240,8 @@ pub fn sig3(v: f64) -> String {
     }
     let digits = (2 - v.abs().log10().floor() as i32).max(0) as usize;
     let s = format!("{v:.digits$}");
-    if s.contains('.') {
-        s.trim_end_matches('0').trim_end_matches('.').to_string()
-    } else {
-        s
-    }
+    let trimmed = s.trim_end_matches('0').trim_end_matches('.');
+    if s.contains('.') { trimmed } else { &s }.to_string()
 }
 
 pub fn summarize(gaps: &[MetricGap], within_noise: bool) -> String {

@@ -372,7 +372,7 @@ impl Inputs<'_> {
 /// 1/1024 and 1/32 of the range; a NaN width (no interval) gives 1/32 (clamp would keep NaN).
 #[expect(clippy::manual_clamp)]
 fn widths(e: &Evidence) -> Vec<f64> {
-    e.intervals
+    e.marginal
         .iter()
         .map(|[a, b]| ((b - a) / 4.0).min(1.0 / 32.0).max(1.0 / 1024.0))
         .collect()

@@ -68,11 +68,12 @@ impl Outcome {
 
 /// The knobs of an explanation's label ("nominal": none).
 pub fn knobs_of(label: &str) -> Vec<String> {
-    if label == "nominal" || label.is_empty() {
-        Vec::new()
-    } else {
-        label.split(" + ").map(str::to_string).collect()
-    }
+    let knob = |k: &&str| !k.is_empty() && *k != "nominal";
+    label
+        .split(" + ")
+        .filter(knob)
+        .map(str::to_string)
+        .collect()
 }
 
 /// A row of a points file of the retired rule-based selection (its answer and names).
@@ -314,32 +315,29 @@ fn questions(noise_levels: &[f64]) -> Vec<Question> {
         names_all_truth,
     ));
     parameter_questions(&mut v);
+    let effect_named: fn(&Scored) -> bool = |s| {
+        let e = truth_effects(s.row);
+        s.named(|n| e.iter().all(|x| n.contains(x)))
+    };
+    let compound_counts = [
+        ("the effect named", "high", effect_named),
+        ("both named", "high", names_all_truth),
+        ("a knob in neither named", "≤ 5 %", names_spurious),
+    ];
     for declared in [true, false] {
         let tag = if declared { "declared" } else { "undeclared" };
-        let compound = move |r: &CaseRow| r.kind == "compound" && r.truth_declared == declared;
-        v.push(q(
-            format!("compound ({tag} parameter error + effect): the effect named"),
-            "high",
-            compound,
-            |s| {
-                let e = truth_effects(s.row);
-                s.named(|n| e.iter().all(|x| n.contains(x)))
-            },
-        ));
-        if declared {
+        // An undeclared number beside an effect is not weighed: "both" cannot be named.
+        for (what, target, counts) in compound_counts
+            .iter()
+            .filter(|c| declared || c.0 != "both named")
+        {
             v.push(q(
-                format!("compound ({tag} parameter error + effect): both named"),
-                "high",
-                compound,
-                names_all_truth,
+                format!("compound ({tag} parameter error + effect): {what}"),
+                target,
+                move |r| r.kind == "compound" && r.truth_declared == declared,
+                *counts,
             ));
         }
-        v.push(q(
-            format!("compound ({tag} parameter error + effect): a knob in neither named"),
-            "≤ 5 %",
-            compound,
-            names_spurious,
-        ));
     }
     drake_questions(&mut v);
     v
@@ -382,11 +380,7 @@ fn parameter_questions(v: &mut Vec<Question>) {
 
 fn drake_questions(v: &mut Vec<Question>) {
     for reference in [false, true] {
-        let tag = if reference {
-            " (through the no-effect trials)"
-        } else {
-            ""
-        };
+        let tag = ["", " (through the no-effect trials)"][reference as usize];
         let d = move |r: &CaseRow| r.kind == "drake" && r.key.contains("-ref/") == reference;
         v.push(q(
             format!("Drake{tag}, no effect added: an effect blamed"),

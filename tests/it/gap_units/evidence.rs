@@ -122,7 +122,8 @@ fn interval_at_a_range_end_holds_the_mode() {
 /// Two linear knobs, two observations y₁ ~ N(10a, 1) = 4 and y₂ ~ N(10a + 10b, 1) = 9: the
 /// posterior is Gaussian at (0.4, 0.5) with precision [[200, 100], [100, 100]]. The
 /// importance sampler's ln Z matches a 1000 × 1000 midpoint grid of the same target to
-/// 0.02, Laplace's to 0.01 (the box and the slabs' holes cut 0.3 % of the Gaussian).
+/// 0.02, Laplace's to 0.01 (the box and the slabs' holes cut 0.3 % of the Gaussian); each
+/// knob's interval spans the joint 95 % region.
 #[test]
 fn two_knob_importance_sampling_matches_a_dense_grid() {
     let (knobs, mut sur) = linear(&[10.0, 10.0]);
@@ -181,6 +182,18 @@ fn two_knob_importance_sampling_matches_a_dense_grid() {
         "{:?}",
         e.mode
     );
+    // The 95 % highest-density region is the ellipse Δᵀ P Δ ≤ χ²₂(0.95) = 5.991; on each axis
+    // it reaches ±√(5.991·Σᵢᵢ) (Σ = P⁻¹: 0.01, 0.02): a ± 0.2448, b ± 0.3462, wider than the
+    // marginals' ±1.96 sd (0.196, 0.277). Samples fill it from inside, so within 0.02.
+    for (i, (m, r)) in [(0.4, 0.2448), (0.5, 0.3462)].into_iter().enumerate() {
+        let [lo, hi] = e.intervals[i];
+        assert!(
+            (lo - (m - r)).abs() < 0.02 && (hi - (m + r)).abs() < 0.02,
+            "{e:?}"
+        );
+        let [mlo, mhi] = e.marginal[i];
+        assert!((mhi - mlo) < hi - lo, "{e:?}");
+    }
     // Same seed, same bits.
     assert_eq!(evidence(&t, 7), e);
 }
