@@ -74,7 +74,7 @@ pub fn check_default_sd(sd: f64) -> Result<(), GapError> {
     let message = "the default relative sd must be finite and > 0";
     (sd > 0.0 && sd.is_finite())
         .then_some(())
-        .ok_or(GapError::Invalid(message.into()))
+        .ok_or_else(|| GapError::Invalid(message.into()))
 }
 
 /// The text of the file at `path`.

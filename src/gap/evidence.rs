@@ -334,6 +334,7 @@ fn one_knob(target: &Target<'_>) -> Evidence {
             .map(|(u, l, c, width)| (vec![u], (l - lmax).exp() * width, c, width))
             .collect(),
     };
+    let intervals = w.intervals(1);
     let log_z_laplace = curvature_sd(target, mode)
         .map(|s| lmax + 0.5 * (2.0 * std::f64::consts::PI).ln() + s.ln())
         .unwrap_or(f64::NAN);
@@ -342,8 +343,8 @@ fn one_knob(target: &Target<'_>) -> Evidence {
         log_z_laplace,
         chi2_mode: target.eval(&[mode]).1,
         mode: vec![mode],
-        intervals: w.intervals(1),
-        marginal: w.intervals(1),
+        marginal: intervals.clone(),
+        intervals,
         fit_p: w.fit_p(target.obs.len()),
         ess: w.ess(),
     }
@@ -539,8 +540,7 @@ fn two_knobs(target: &Target<'_>, seed: u64) -> Evidence {
 /// weight, χ², ln density): the densest samples holding 95 % of the weight, and the mode,
 /// which a marginal interval of a thin ridge can miss.
 fn region(samples: &[(Vec<f64>, f64, f64, f64)], top: f64, mode: &[f64]) -> Vec<[f64; 2]> {
-    let mut by_density: Vec<&(Vec<f64>, f64, f64, f64)> =
-        samples.iter().filter(|p| p.1.is_finite()).collect();
+    let mut by_density: Vec<_> = samples.iter().filter(|p| p.1.is_finite()).collect();
     by_density.sort_by(|a, b| b.3.total_cmp(&a.3));
     let need = 0.95 * by_density.iter().map(|p| (p.1 - top).exp()).sum::<f64>();
     let (mut out, mut held) = (mode.iter().map(|m| [*m, *m]).collect::<Vec<_>>(), 0.0);
@@ -688,6 +688,7 @@ impl Discrepancy {
                 .map(|&(t, l, c)| (vec![(t - lo) / (hi - lo)], (l - lmax).exp() * h, c, du))
                 .collect(),
         };
+        let unit = w.intervals(1);
         let best = cells
             .iter()
             .max_by(|a, b| a.1.total_cmp(&b.1))
@@ -698,12 +699,11 @@ impl Discrepancy {
             log_z_laplace: f64::NAN,
             mode: vec![best.0.exp()],
             chi2_mode: best.2,
-            intervals: w
-                .intervals(1)
-                .into_iter()
+            intervals: unit
+                .iter()
                 .map(|[a, b]| [(lo + a * (hi - lo)).exp(), (lo + b * (hi - lo)).exp()])
                 .collect(),
-            marginal: w.intervals(1),
+            marginal: unit,
             fit_p: w.fit_p(obs.len()),
             ess: w.ess(),
         }
