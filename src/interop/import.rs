@@ -9,18 +9,22 @@
 //! * the frame: y along the hip axis (sign: the base leg's COM on +y), z up (against gravity,
 //!   made normal to y), x = y × z; the hip point on the axis, midway between the legs' COMs;
 //! * each leg's foot is its contact geometry lowest along −z: a sphere or an ellipsoid along
-//!   the axes as it is, else (a mesh, a turned ellipsoid) the best-fitting ellipsoid of its
-//!   convex hull where a floor can touch it; a mesh foot whose inner edge cuts its ellipsoid becomes a section
+//!   the axes as it is, a capsule within 5° of vertical as the sphere about its lower end,
+//!   else (a mesh, a turned ellipsoid, a box, a cylinder, a tilted capsule) the best-fitting
+//!   ellipsoid of its convex hull where a floor can touch it (a box's, cylinder's or
+//!   capsule's set down on its lowest point); a mesh foot whose inner edge cuts its ellipsoid becomes a section
 //!   (`foot_section_cut_over_l`); L is the hip's height above the feet;
 //! * the design is symmetric: one mass split equally, the legs' COM offsets, inertia boxes
 //!   and feet averaged; what that averages away is said in the file.
+
+mod control;
 
 use std::path::Path;
 
 use nalgebra::Vector3;
 
-use super::legs::{LegRead, WalkerFrame, read_legs, topo, world_frames};
-use super::robot_file::{Actuator, Body, Joint, RobotFile, Shape, read_text};
+use super::legs::{LegRead, read_legs, topo, world_frames};
+use super::robot_file::{RobotFile, Shape, read_text};
 use super::soft_contact::pressure_field_of;
 use super::{CUSTOM_PREFIX, InteropError};
 use super::{mjcf, urdf};
@@ -183,7 +187,7 @@ pub fn import(path: &Path, opts: &ImportOptions) -> Result<Imported, InteropErro
     let l = b.num("geometry.leg_length_m").unwrap_or(1.0);
     let m = b.num("mass.total_mass_kg").unwrap_or(1.0);
     contact(&mut b, &legs, l, m);
-    control(&mut b, &legs, l, m, &wf)?;
+    control::control(&mut b, &legs, l, m, &wf)?;
     start_and_criteria(&mut b, &legs, l, m);
     custom_values(&mut b)?;
     if let Some(sc) = &opts.sidecar {
@@ -339,7 +343,8 @@ fn inertia_box(b: &mut Builder, legs: &[LegRead; 2], l: f64) {
     );
 }
 
-/// The largest extent of the file's geometry (vertices of meshes, extents of primitives).
+/// The largest extent of the file's geometry (vertices of meshes, the exact bounding boxes
+/// of primitives as they are turned).
 fn body_extent(f: &RobotFile) -> f64 {
     let frames = world_frames(f);
     let mut lo = Vector3::repeat(f64::INFINITY);
@@ -347,17 +352,32 @@ fn body_extent(f: &RobotFile) -> f64 {
     for (b, fr) in f.bodies.iter().zip(&frames) {
         for g in &b.geoms {
             let gf = fr.then(&g.frame);
-            let pts: Vec<Vector3<f64>> = match &g.shape {
-                Shape::Mesh(m) => m.vertices.clone(),
-                Shape::Sphere(r) => vec![Vector3::repeat(*r), Vector3::repeat(-r)],
-                Shape::Ellipsoid(s) | Shape::Box(s) => vec![*s, -s],
-                Shape::Capsule(r, h) | Shape::Cylinder(r, h) => {
-                    vec![Vector3::new(*r, *r, h + r), Vector3::new(-r, -r, -h - r)]
+            let r = &gf.r;
+            // Half extents along the world's axes of a primitive centred on its frame.
+            let half = |i: usize| -> f64 {
+                match &g.shape {
+                    Shape::Sphere(s) => *s,
+                    Shape::Ellipsoid(s) => (0..3)
+                        .map(|j| (r[(i, j)] * s[j]).powi(2))
+                        .sum::<f64>()
+                        .sqrt(),
+                    Shape::Box(s) => (0..3).map(|j| (r[(i, j)] * s[j]).abs()).sum(),
+                    Shape::Capsule(rad, h) => r[(i, 2)].abs() * h + rad,
+                    Shape::Cylinder(rad, h) => {
+                        r[(i, 2)].abs() * h + rad * (1.0 - r[(i, 2)].powi(2)).max(0.0).sqrt()
+                    }
+                    Shape::Mesh(_) | Shape::Plane => 0.0,
                 }
-                Shape::Plane => vec![],
             };
-            for p in pts {
-                let w = gf.r * p + gf.p;
+            let pts: Vec<Vector3<f64>> = match &g.shape {
+                Shape::Mesh(m) => m.vertices.iter().map(|p| r * p + gf.p).collect(),
+                Shape::Plane => vec![],
+                _ => {
+                    let h = Vector3::new(half(0), half(1), half(2));
+                    vec![gf.p - h, gf.p + h]
+                }
+            };
+            for w in pts {
                 lo = lo.inf(&w);
                 hi = hi.sup(&w);
             }
@@ -421,293 +441,6 @@ fn contact(b: &mut Builder, legs: &[LegRead; 2], l: f64, m: f64) {
         defaults::STICTION_SPEED_OVER_SQRT_GL * (GRAVITY_MPS2 * l).sqrt(),
         "the reference set's 0.1 mm/s at L = 0.153 m, ∝ √(gL)",
     );
-}
-
-/// The free roll rocking frequency [Hz] of the walker on its feet with the legs together:
-/// ω² = m·g·(R − h)/(I + m·h²), R the feet's lateral radius of curvature R_Y²/R_Z, h the COM
-/// height (a rigid rocker, ../shared/research/walkers.md §4.3); None when not a rocker.
-fn rocking_hz(legs: &[LegRead; 2], l: f64) -> Option<f64> {
-    let m = legs[0].mass.mass_kg + legs[1].mass.mass_kg;
-    let semi = 0.5 * (legs[0].foot_semi + legs[1].foot_semi);
-    let r = semi.y * semi.y / semi.z;
-    let both = legs[0].mass.combined(&legs[1].mass);
-    let h = l + both.com_m.z;
-    let i = both.inertia_com_kgm2[(0, 0)];
-    let w2 = m * GRAVITY_MPS2 * (r - h) / (i + m * h * h);
-    (w2 > 0.0).then(|| w2.sqrt() / std::f64::consts::TAU)
-}
-
-/// The scales the control's values are given in (m·g·L, √(L/g)) and the drive frequency
-/// the file lacks, with why.
-struct Scales {
-    mgl: f64,
-    tl: f64,
-    f_drive: f64,
-    why: String,
-}
-
-/// The default drive frequency: 0.97 × the free roll rocking frequency, else √(g/L)/2π;
-/// with the reason given as its source.
-fn drive_frequency(legs: &[LegRead; 2], l: f64) -> (f64, String) {
-    match rocking_hz(legs, l) {
-        Some(fr) => (
-            defaults::DRIVE_OVER_ROCKING * fr,
-            format!(
-                "0.97 × the free roll rocking frequency {fr:.3} Hz of this walker (the bundled designs' rule)"
-            ),
-        ),
-        None => (
-            ((GRAVITY_MPS2 / l).sqrt()) / std::f64::consts::TAU,
-            "√(g/L)/2π: the feet are no rocker under this COM".to_string(),
-        ),
-    }
-}
-
-/// `[control]` and the hip: the drive from the hip's actuator (else the reference servo),
-/// the stop from its range, its damping and friction as effects.
-fn control(
-    b: &mut Builder,
-    legs: &[LegRead; 2],
-    l: f64,
-    m: f64,
-    wf: &WalkerFrame,
-) -> Result<(), InteropError> {
-    let f = b.f;
-    let (f_drive, why) = drive_frequency(legs, l);
-    let s = Scales {
-        mgl: m * GRAVITY_MPS2 * l,
-        tl: (l / GRAVITY_MPS2).sqrt(),
-        f_drive,
-        why,
-    };
-    let hinge = f
-        .bodies
-        .iter()
-        .find(|x| matches!(x.joint, Joint::Hinge { .. }));
-    let hip_name = hinge.map(|h| h.joint_name.clone()).unwrap_or_default();
-    let act = f.actuators.iter().find(|a| match a {
-        Actuator::Position { joint, .. } | Actuator::Torque { joint, .. } => *joint == hip_name,
-    });
-    match act {
-        Some(Actuator::Position {
-            kp,
-            kv,
-            force_limit,
-            ..
-        }) => servo_from_file(b, &s, *kp, *kv, *force_limit),
-        Some(Actuator::Torque {
-            limit,
-            velocity_damping,
-            ..
-        }) => bang_bang_from_file(b, &s, *limit, *velocity_damping),
-        None => servo_by_default(b, &s),
-    }
-    if let Some(Body {
-        joint:
-            Joint::Hinge {
-                range,
-                damping,
-                frictionloss,
-                solreflimit,
-                ..
-            },
-        ..
-    }) = hinge
-    {
-        if let Some(range) = range {
-            hardstop(b, legs, &s, wf, *range, *solreflimit);
-        }
-        hip_effects(b, l, *damping, *frictionloss);
-    }
-    Ok(())
-}
-
-/// A servo from the hip's position actuator: its gains and force range (the drive's
-/// amplitude and frequency are defaults).
-fn servo_from_file(b: &mut Builder, s: &Scales, kp: f64, kv: f64, force_limit: Option<f64>) {
-    let f = b.f;
-    b.put(
-        "control.kind",
-        "servo_sine",
-        from_file(f, "the hip's position actuator"),
-    );
-    b.default(
-        "control.amplitude_deg",
-        defaults::AMPLITUDE_DEG,
-        "the reference set's servo amplitude",
-    );
-    b.default("control.frequency_hz", s.f_drive, &s.why);
-    b.file(
-        "control.kp_over_mgl",
-        kp / s.mgl,
-        &format!("the position actuator's kp = {kp} N·m/rad"),
-    );
-    b.file(
-        "control.kd_over_mgl_sqrt_l_over_g",
-        kv / (s.mgl * s.tl),
-        &format!("the position actuator's kv = {kv} N·m·s/rad"),
-    );
-    match force_limit {
-        Some(t) => b.file("control.torque_limit_nm", t, "the actuator's force range"),
-        None => b.default(
-            "control.torque_limit_nm",
-            defaults::TORQUE_LIMIT_OVER_MGL * s.mgl,
-            "the reference set's 0.74 m·g·L",
-        ),
-    }
-}
-
-/// A bang-bang drive from the hip's torque actuator: its force range as the torque, its
-/// velocity bias as the motor's torque–speed line.
-fn bang_bang_from_file(b: &mut Builder, s: &Scales, limit: Option<f64>, velocity_damping: f64) {
-    let f = b.f;
-    b.put(
-        "control.kind",
-        "bang_bang",
-        from_file(
-            f,
-            "the hip's torque actuator (driven bang-bang against the stops)",
-        ),
-    );
-    match limit {
-        Some(t) => b.file("control.torque_nm", t, "the actuator's force range"),
-        None => b.default(
-            "control.torque_nm",
-            defaults::BANG_BANG_TORQUE_OVER_MGL * s.mgl,
-            "the reference set's 0.66 m·g·L",
-        ),
-    }
-    b.default("control.frequency_hz", s.f_drive, &s.why);
-    if velocity_damping > 0.0 {
-        let tau = b.num("control.torque_nm").unwrap_or(0.0);
-        b.notes.push(format!("the actuator's velocity bias {velocity_damping} N·m·s/rad is a motor torque–speed line: no-load speed {:.3} rad/s", tau / velocity_damping));
-        b.put(
-            "effects",
-            toml::Value::Array(vec![effect_table(&EffectSpec::MotorTorqueSpeed {
-                no_load_speed_rad_s: tau / velocity_damping,
-            })]),
-            from_file(
-                f,
-                "the actuator's velocity bias, as the motor torque–speed line",
-            ),
-        );
-    }
-}
-
-/// The reference set's servo, for a file with no actuator on the hip.
-fn servo_by_default(b: &mut Builder, s: &Scales) {
-    b.default(
-        "control.kind",
-        "servo_sine",
-        "the file has no actuator on the hip",
-    );
-    b.default(
-        "control.amplitude_deg",
-        defaults::AMPLITUDE_DEG,
-        "the reference set's servo amplitude",
-    );
-    b.default("control.frequency_hz", s.f_drive, &s.why);
-    b.default(
-        "control.kp_over_mgl",
-        defaults::KP_OVER_MGL,
-        "the reference set's stiff position servo",
-    );
-    b.default(
-        "control.kd_over_mgl_sqrt_l_over_g",
-        defaults::KD_OVER_MGL_SQRT_L_OVER_G,
-        "the reference set's servo damping",
-    );
-    b.default(
-        "control.torque_limit_nm",
-        defaults::TORQUE_LIMIT_OVER_MGL * s.mgl,
-        "the reference set's 0.74 m·g·L",
-    );
-}
-
-/// The hip's stop from its range [lo, hi]: the smaller side as the limit, the spring and
-/// damper from the limit's solreflimit (else the defaults).
-fn hardstop(
-    b: &mut Builder,
-    legs: &[LegRead; 2],
-    s: &Scales,
-    wf: &WalkerFrame,
-    [lo, hi]: [f64; 2],
-    solreflimit: Option<[f64; 2]>,
-) {
-    let lim = lo.abs().min(hi.abs());
-    b.file("hardstop.limit_deg", lim.to_degrees(), &format!("the hip's range [{:.4}, {:.4}] rad (the smaller side; q's sign follows the walker's y, {} the file's axis)", lo, hi, if wf.axis_sign > 0.0 { "along" } else { "against" }));
-    match solreflimit {
-        Some([tc, zeta]) if tc > 0.0 && zeta > 0.0 => {
-            // Invert the export's matching on the hip's effective inertia.
-            let i = hip_inertia(legs);
-            let w = 1.0 / (tc * zeta);
-            b.file("hardstop.stiffness_over_mgl", i * w * w / s.mgl, &format!("the closest stop spring to the joint limit's solreflimit ({tc}, {zeta}) on the hip's inertia {i:.3e} kg·m²"));
-            b.file(
-                "hardstop.damping_over_mgl_sqrt_l_over_g",
-                2.0 * zeta * w * i / (s.mgl * s.tl),
-                "the closest stop damper: the same damping ratio on that inertia",
-            );
-        }
-        _ => {
-            b.default(
-                "hardstop.stiffness_over_mgl",
-                defaults::HARDSTOP_STIFFNESS_OVER_MGL,
-                "a stiff stop: 1 m·g·L of torque overshoots 0.6°",
-            );
-            b.default(
-                "hardstop.damping_over_mgl_sqrt_l_over_g",
-                defaults::HARDSTOP_DAMPING,
-                "a well damped stop",
-            );
-        }
-    }
-}
-
-/// The hip joint's damping and friction loss as the design's effects (after any motor
-/// line already read).
-fn hip_effects(b: &mut Builder, l: f64, damping: f64, frictionloss: f64) {
-    let f = b.f;
-    let mut effects: Vec<toml::Value> = b
-        .entries
-        .iter()
-        .find(|e| e.path == "effects")
-        .and_then(|e| e.value.as_array().cloned())
-        .unwrap_or_default();
-    if damping > 0.0 {
-        effects.push(effect_table(&EffectSpec::HipViscousDamping {
-            damping_nms_per_rad: damping,
-        }));
-    }
-    if frictionloss > 0.0 {
-        effects.push(effect_table(&EffectSpec::HipCoulombFriction {
-            friction_torque_nm: frictionloss,
-            stiction_rate_rad_s: 0.05 * (GRAVITY_MPS2 / l).sqrt(),
-        }));
-        b.notes.push("the hip's friction loss is the design's Coulomb friction, regularised below 0.05·√(g/L) (the effect library's default)".into());
-    }
-    if !effects.is_empty() {
-        b.put(
-            "effects",
-            toml::Value::Array(effects),
-            from_file(
-                f,
-                "the hip joint's damping / friction and the actuator's velocity bias",
-            ),
-        );
-    }
-}
-
-/// The hip coordinate's effective inertia with the legs together (free-floating): the
-/// relative rotation about y of two bodies, I₀·I₁/(I₀ + I₁) about their COMs' pivot, a
-/// lower bound the export's MuJoCo stop was matched on (the exact value comes from the mass
-/// matrix; both give the same timeconst for a design exported by this project).
-fn hip_inertia(legs: &[LegRead; 2]) -> f64 {
-    let i = |k: usize| {
-        let m = &legs[k].mass;
-        m.inertia_com_kgm2[(1, 1)] + m.mass_kg * (m.com_m.x * m.com_m.x + m.com_m.z * m.com_m.z)
-    };
-    let (a, b) = (i(0), i(1));
-    a * b / (a + b)
 }
 
 fn effect_table(e: &EffectSpec) -> toml::Value {

@@ -8,6 +8,8 @@ use super::mesh::{MassProps, TriMesh, ellipsoid_section, fit_ellipsoid};
 use super::robot_file::{Body, Frame, Geom, Joint, RobotFile, Shape};
 use crate::sim::GRAVITY_MPS2;
 
+mod foot_shapes;
+
 /// A leg as read: mass properties and foot in the walker's frame (hip point at the origin).
 pub(super) struct LegRead {
     pub(super) name: String,
@@ -190,7 +192,9 @@ fn walker_frame(
     })
 }
 
-/// A geometry as a mesh in the walker's frame, for the lowest point and the fit.
+/// A geometry's surface in the walker's frame, for the fit: a sphere's or ellipsoid's as a
+/// mesh, a mesh as it is, a box's, cylinder's or capsule's surface points (no triangles:
+/// only the hull's support points are used). None for a plane.
 fn geom_points(g: &Geom, to_walker: &Frame) -> Option<TriMesh> {
     let whole =
         |semi: Vector3<f64>| ellipsoid_section(&Vector3::zeros(), &semi, 1.0, -semi.y * 2.0);
@@ -198,7 +202,10 @@ fn geom_points(g: &Geom, to_walker: &Frame) -> Option<TriMesh> {
         Shape::Sphere(r) => whole(Vector3::repeat(*r)),
         Shape::Ellipsoid(s) => whole(*s),
         Shape::Mesh(m) => m.clone(),
-        _ => return None,
+        other => TriMesh {
+            vertices: foot_shapes::surface_points(other)?,
+            triangles: Vec::new(),
+        },
     };
     let fr = to_walker.then(&g.frame);
     Some(m.transformed(&fr.r, &fr.p))
@@ -224,61 +231,78 @@ fn axis_permutation(r: &Matrix3<f64>) -> Option<[usize; 3]> {
 /// section.
 type Foot = (Vector3<f64>, Vector3<f64>, String, String, Option<f64>);
 
+/// A leg's lowest collision geometry: its lowest height, the geometry, its frame in the
+/// walker's and its surface there; or the error saying the leg has none.
+fn lowest_geom<'a>(
+    f: &RobotFile,
+    geoms: &'a [(Geom, Frame)],
+    leg_name: &str,
+) -> Result<(f64, &'a Geom, Frame, TriMesh), InteropError> {
+    let mut best: Option<(f64, &Geom, Frame, TriMesh)> = None;
+    for (g, to_w) in geoms.iter().filter(|(g, _)| g.contact) {
+        let fr = to_w.then(&g.frame);
+        let (Some(m), Some(low)) = (geom_points(g, to_w), foot_shapes::lowest_z(&g.shape, &fr))
+        else {
+            continue;
+        };
+        if best.as_ref().is_none_or(|b| low < b.0) {
+            best = Some((low, g, fr, m));
+        }
+    }
+    best.ok_or_else(|| {
+        let kinds: Vec<String> = geoms
+            .iter()
+            .filter(|(g, _)| g.contact)
+            .map(|(g, _)| format!("`{}` ({})", g.name, shape_word(&g.shape)))
+            .collect();
+        topo(
+            f,
+            format!(
+                "leg `{leg_name}` has no foot: {}; a foot is a leg's lowest sphere, ellipsoid, capsule, box, cylinder or mesh collision geometry",
+                if kinds.is_empty() {
+                    "it has no collision geometry".to_string()
+                } else {
+                    format!("its only collision geometry is {}", kinds.join(", "))
+                }
+            ),
+        )
+    })
+}
+
 fn read_foot(
     f: &RobotFile,
     geoms: &[(Geom, Frame)],
     leg_name: &str,
     side: f64,
 ) -> Result<Foot, InteropError> {
-    let mut best: Option<(f64, &Geom, &Frame, TriMesh)> = None;
-    for (g, to_w) in geoms.iter().filter(|(g, _)| g.contact) {
-        let Some(m) = geom_points(g, to_w) else {
-            continue;
-        };
-        let low = m.vertices.iter().map(|v| v.z).fold(f64::INFINITY, f64::min);
-        if best.as_ref().is_none_or(|b| low < b.0) {
-            best = Some((low, g, to_w, m));
-        }
-    }
-    let Some((_, g, to_w, m)) = best else {
-        let kinds: Vec<String> = geoms
-            .iter()
-            .filter(|(g, _)| g.contact)
-            .map(|(g, _)| format!("`{}`", g.name))
-            .collect();
-        return Err(topo(
-            f,
-            format!(
-                "leg `{leg_name}` has no foot: no sphere, ellipsoid or mesh collision geometry ({}); the design's feet are ellipsoids",
-                if kinds.is_empty() {
-                    "it has no collision geometry".to_string()
-                } else {
-                    format!("it has {}", kinds.join(", "))
-                }
-            ),
-        ));
-    };
-    let fr = to_w.then(&g.frame);
+    let (low, g, fr, m) = lowest_geom(f, geoms, leg_name)?;
     let exact = match &g.shape {
-        Shape::Sphere(r) => Some(Vector3::repeat(*r)),
-        Shape::Ellipsoid(s) => {
-            axis_permutation(&fr.r).map(|p| Vector3::new(s[p[0]], s[p[1]], s[p[2]]))
-        }
-        _ => None,
+        Shape::Sphere(r) => Some((fr.p, Vector3::repeat(*r), "as it is".to_string())),
+        Shape::Ellipsoid(s) => axis_permutation(&fr.r).map(|p| {
+            let semi = Vector3::new(s[p[0]], s[p[1]], s[p[2]]);
+            (fr.p, semi, "as it is".to_string())
+        }),
+        other => foot_shapes::upright_capsule_end(other, &fr).map(|(c, r)| {
+            let how = format!(
+                "within {}° of vertical: the sphere of its radius about its lower end point (exactly the capsule near the ground)",
+                foot_shapes::UPRIGHT_CAPSULE_DEG
+            );
+            (c, Vector3::repeat(r), how)
+        }),
     };
-    if let Some(semi) = exact {
+    if let Some((c, semi, how)) = exact {
         return Ok((
-            fr.p,
+            c,
             semi,
             g.name.clone(),
-            format!("{} `{}` as it is", shape_word(&g.shape), g.name),
+            format!("{} `{}` {how}", shape_word(&g.shape), g.name),
             None,
         ));
     }
     // The hull's support points within 60° of straight down: the walkers roll and pitch
     // well within that.
     let pts = m.support_points(&-Vector3::z(), 60f64.to_radians());
-    let fit = fit_ellipsoid(&pts).ok_or_else(|| {
+    let mut fit = fit_ellipsoid(&pts).ok_or_else(|| {
         topo(
             f,
             format!(
@@ -287,13 +311,30 @@ fn read_foot(
             ),
         )
     })?;
+    // A box, cylinder or capsule: the fit of its few corner or rim points need not stand
+    // where the geometry does (four corners of a flat face pin no height), so it is set
+    // down on the geometry's lowest point: the file's standing height is kept.
+    let primitive = !matches!(g.shape, Shape::Mesh(_) | Shape::Ellipsoid(_));
+    let placed = if primitive {
+        let dz = low - (fit.center_m.z - fit.semi_axes_m.z);
+        fit = fit.moved_z(dz, &pts);
+        format!(
+            ", moved {:.2} mm {} so its lowest point is the {}'s",
+            dz.abs() * 1e3,
+            if dz >= 0.0 { "up" } else { "down" },
+            shape_word(&g.shape)
+        )
+    } else {
+        String::new()
+    };
     let how = format!(
-        "best-fitting {} of the {} convex-hull points of {} `{}` a floor touches within 60° of upright (rms {:.2} mm; the file's geometry replaced)",
+        "best-fitting {} of the {} convex-hull points of {} `{}` a floor touches within 60° of upright{placed} (rms {:.2} mm{}; the file's geometry replaced)",
         if fit.sphere { "sphere" } else { "ellipsoid" },
         pts.len(),
         shape_word(&g.shape),
         g.name,
-        fit.rms_m * 1e3
+        fit.rms_m * 1e3,
+        if primitive { " as placed" } else { "" },
     );
     let inner = m
         .vertices

@@ -241,6 +241,18 @@ pub struct EllipsoidFit {
     pub sphere: bool,
 }
 
+impl EllipsoidFit {
+    /// The same ellipsoid moved `dz` along z, its rms recomputed over `points` as placed.
+    pub fn moved_z(&self, dz: f64, points: &[Vector3<f64>]) -> EllipsoidFit {
+        let center = self.center_m + Vector3::z() * dz;
+        EllipsoidFit {
+            center_m: center,
+            rms_m: rms_of(points, &center, &self.semi_axes_m),
+            ..*self
+        }
+    }
+}
+
 fn rms_of(points: &[Vector3<f64>], c: &Vector3<f64>, s: &Vector3<f64>) -> f64 {
     let n = points.len().max(1) as f64;
     let sum: f64 = points
@@ -259,7 +271,8 @@ fn rms_of(points: &[Vector3<f64>], c: &Vector3<f64>, s: &Vector3<f64>) -> f64 {
 /// Best-fitting ellipsoid (axes along the frame's) of `points` by algebraic least squares,
 /// A x² + B y² + C z² + D x + E y + F z = 1, against the best sphere
 /// x² + y² + z² = 2a·x + 2b·y + 2c·z + k; the ellipsoid is kept when it is closed and fits
-/// at least 20 % better (rms distance). None with fewer than 4 points or a degenerate set.
+/// at least 20 % better (rms distance) than a sphere that does not already fit to rounding.
+/// None with fewer than 4 points or a degenerate set.
 pub fn fit_ellipsoid(points: &[Vector3<f64>]) -> Option<EllipsoidFit> {
     if points.len() < 4 {
         return None;
@@ -326,7 +339,9 @@ pub fn fit_ellipsoid(points: &[Vector3<f64>]) -> Option<EllipsoidFit> {
         })
         .flatten();
     match (sphere, ellipsoid) {
-        (Some(s), Some(e)) if e.rms_m < 0.8 * s.rms_m => Some(e),
+        // A sphere fitting to rounding (a capsule's end, a sphere as a mesh) is kept: there
+        // an ellipsoid's "better" rms is rounding too.
+        (Some(s), Some(e)) if e.rms_m < 0.8 * s.rms_m && s.rms_m > 1e-9 * scale => Some(e),
         (Some(s), _) => Some(s),
         (None, e) => e,
     }

@@ -92,7 +92,8 @@ impl<'a> Mjcf<'a> {
                         return Err(bad(file, doc, sec, "no `file` attribute".into()));
                     };
                     let inc = self.dir.join(f);
-                    let (text, sha) = read_text(&inc)?;
+                    let (text, sha) =
+                        read_text(&inc).map_err(|e| bad(file, doc, sec, e.to_string()))?;
                     let idoc =
                         roxmltree::Document::parse(&text).map_err(|e| InteropError::Invalid {
                             file: inc.display().to_string(),
@@ -213,6 +214,9 @@ impl<'a> Mjcf<'a> {
         cc: &str,
     ) -> Result<Matrix3<f64>, InteropError> {
         if let Some(q) = self.floats(doc, file, node, "quat", Some(cc), 4)? {
+            if q[..4].iter().all(|x| *x == 0.0) {
+                return Err(bad(file, doc, node, "`quat` is zero: no rotation".into()));
+            }
             return Ok(quat(q[0], q[1], q[2], q[3]));
         }
         if let Some(a) = self.floats(doc, file, node, "axisangle", Some(cc), 4)? {
@@ -483,6 +487,10 @@ impl<'a> Mjcf<'a> {
             solreflimit: self
                 .floats(doc, file, j, "solreflimit", Some(cc), 2)?
                 .map(|v| [v[0], v[1]]),
+            effort_limit: self
+                .floats(doc, file, j, "actuatorfrcrange", Some(cc), 2)?
+                .filter(|_| self.attr(j, "actuatorfrclimited", cc) != Some("false"))
+                .map(|r| r[0].abs().min(r[1].abs())),
         })
     }
 
@@ -592,6 +600,14 @@ impl<'a> Mjcf<'a> {
                 Ok(())
             }
         };
+        if let Some(x) = size.iter().find(|x| **x < 0.0) {
+            return Err(bad(
+                file,
+                doc,
+                g,
+                format!("`size` {x} is negative: sizes are lengths"),
+            ));
+        }
         let fromto = self.floats(doc, file, g, "fromto", Some(cc), 6)?;
         let mut frame = None;
         let shape = match kind {
@@ -611,6 +627,9 @@ impl<'a> Mjcf<'a> {
                 need(1)?;
                 let half = if let Some(ft) = &fromto {
                     let (a, b) = (vec3(&ft[..3]), vec3(&ft[3..]));
+                    if (b - a).norm() == 0.0 {
+                        return Err(bad(file, doc, g, "`fromto` has zero length".into()));
+                    }
                     let z = (b - a).normalize();
                     let r = UnitQuaternion::rotation_between(&Vector3::z(), &z)
                         .unwrap_or_else(UnitQuaternion::identity);
@@ -650,6 +669,12 @@ impl<'a> Mjcf<'a> {
         Ok((shape, frame))
     }
 
+    /// The hip's actuators as joint torques: MuJoCo's actuator force (gain·ctrl + bias,
+    /// clamped to `forcerange`) times the `gear`, so a position servo's stiffness and
+    /// damping are gear²·kp and gear²·kv and its torque limit gear·forcerange; a motor's
+    /// (or a bias-free `general`'s) control range times its gain bounds its force too; a
+    /// `general` with an affine bias pulling back on the joint's position is a position
+    /// servo.
     fn read_actuators(
         &mut self,
         doc: &roxmltree::Document,
@@ -658,10 +683,10 @@ impl<'a> Mjcf<'a> {
     ) -> Result<(), InteropError> {
         for a in sec.children().filter(|n| n.is_element()) {
             let joint = a.attribute("joint").unwrap_or("").to_string();
-            let limit = |s: &Self| -> Result<Option<f64>, InteropError> {
-                let fl = s.attr(a, "forcelimited", "main");
-                Ok(s.floats(doc, file, a, "forcerange", Some("main"), 2)?
-                    .filter(|_| fl != Some("false"))
+            let range = |s: &Self, k: &str| -> Result<Option<f64>, InteropError> {
+                let limited = s.attr(a, &k.replace("range", "limited"), "main");
+                Ok(s.floats(doc, file, a, k, Some("main"), 2)?
+                    .filter(|_| limited != Some("false"))
                     .map(|r| r[0].abs().min(r[1].abs())))
             };
             let one = |s: &Self, k: &str, d: f64| -> Result<f64, InteropError> {
@@ -669,35 +694,59 @@ impl<'a> Mjcf<'a> {
                     .map(|v| v[0])
                     .unwrap_or(d))
             };
-            match a.tag_name().name() {
-                "position" => self.out.actuators.push(Actuator::Position {
+            let gear = one(self, "gear", 1.0)?;
+            let force = range(self, "forcerange")?;
+            let ctrl = range(self, "ctrlrange")?;
+            let min = |x: Option<f64>, y: Option<f64>| match (x, y) {
+                (Some(x), Some(y)) => Some(x.min(y)),
+                (x, y) => x.or(y),
+            };
+            let g2 = gear * gear;
+            let actuator = match a.tag_name().name() {
+                "position" => Actuator::Position {
                     joint,
-                    kp: one(self, "kp", 1.0)?,
-                    kv: one(self, "kv", 0.0)?,
-                    force_limit: limit(self)?,
-                }),
-                "motor" => self.out.actuators.push(Actuator::Torque {
+                    kp: g2 * one(self, "kp", 1.0)?,
+                    kv: g2 * one(self, "kv", 0.0)?,
+                    force_limit: force.map(|t| gear.abs() * t),
+                },
+                "motor" => Actuator::Torque {
                     joint,
-                    limit: limit(self)?,
+                    limit: min(force, ctrl).map(|t| gear.abs() * t),
                     velocity_damping: 0.0,
-                }),
+                },
                 "general" => {
-                    let bias = self
-                        .floats(doc, file, a, "biasprm", Some("main"), 0)?
-                        .unwrap_or_default();
+                    let num = |k: &str| -> Result<Vec<f64>, InteropError> {
+                        Ok(self
+                            .floats(doc, file, a, k, Some("main"), 0)?
+                            .unwrap_or_default())
+                    };
+                    let gain = num("gainprm")?.first().copied().unwrap_or(1.0);
+                    let bias = num("biasprm")?;
+                    let b = |i: usize| bias.get(i).copied().unwrap_or(0.0);
                     let affine = self.attr(a, "biastype", "main") == Some("affine");
-                    self.out.actuators.push(Actuator::Torque {
-                        joint,
-                        limit: limit(self)?,
-                        velocity_damping: if affine {
-                            -bias.get(2).copied().unwrap_or(0.0)
+                    if affine && b(1) < 0.0 {
+                        Actuator::Position {
+                            joint,
+                            kp: -g2 * b(1),
+                            kv: -g2 * b(2),
+                            force_limit: force.map(|t| gear.abs() * t),
+                        }
+                    } else {
+                        let ctrl_force = if affine {
+                            None
                         } else {
-                            0.0
-                        },
-                    });
+                            ctrl.map(|c| gain.abs() * c)
+                        };
+                        Actuator::Torque {
+                            joint,
+                            limit: min(force, ctrl_force).map(|t| gear.abs() * t),
+                            velocity_damping: if affine { -g2 * b(2) } else { 0.0 },
+                        }
+                    }
                 }
-                _ => {}
-            }
+                _ => continue,
+            };
+            self.out.actuators.push(actuator);
         }
         Ok(())
     }

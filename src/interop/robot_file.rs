@@ -87,6 +87,9 @@ pub enum Joint {
         damping: f64,
         frictionloss: f64,
         solreflimit: Option<[f64; 2]>,
+        /// The largest actuator torque the joint declares [N·m] (URDF `<limit effort>`,
+        /// MJCF `actuatorfrcrange`): a limit on whatever drives the joint.
+        effort_limit: Option<f64>,
     },
     /// Any other kind, by its name in the file.
     Other(String),

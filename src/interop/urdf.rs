@@ -230,24 +230,34 @@ fn joint_kind(
     limit: Option<Node>,
 ) -> Result<Joint, InteropError> {
     let dynamics = j.children().find(|n| n.has_tag_name("dynamics"));
-    let dyn_value = |k: &str| {
-        dynamics
-            .and_then(|d| d.attribute(k))
-            .and_then(|v| v.parse::<f64>().ok())
-            .unwrap_or(0.0)
+    let dyn_value = |k: &str| match dynamics.filter(|d| d.attribute(k).is_some()) {
+        Some(d) => urdf_value(path, doc, d, k),
+        None => Ok(0.0),
     };
     Ok(match kind {
         "fixed" => Joint::Weld,
         "floating" => Joint::Free,
         "revolute" | "continuous" => {
-            let axis = j
-                .children()
-                .find(|n| n.has_tag_name("axis"))
-                .and_then(|a| a.attribute("xyz"))
-                .and_then(parse_floats)
-                .filter(|x| x.len() == 3)
-                .map(|x| vec3(&x))
-                .unwrap_or_else(Vector3::x);
+            let axis = match j.children().find(|n| n.has_tag_name("axis")) {
+                None => Vector3::x(),
+                Some(a) => {
+                    let v = a.attribute("xyz").unwrap_or("");
+                    match parse_floats(v) {
+                        Some(x) if x.len() == 3 && x.iter().all(|c| c.is_finite()) => vec3(&x),
+                        _ => {
+                            return Err(bad(
+                                path,
+                                doc,
+                                a,
+                                format!("`xyz` = \"{v}\": expected 3 numbers"),
+                            ));
+                        }
+                    }
+                }
+            };
+            if axis.norm() == 0.0 {
+                return Err(bad(path, doc, j, "the joint's axis is zero".into()));
+            }
             let range = match (kind, limit) {
                 ("revolute", Some(l)) => Some([
                     urdf_value(path, doc, l, "lower")?,
@@ -255,13 +265,18 @@ fn joint_kind(
                 ]),
                 _ => None,
             };
+            let effort_limit = match limit.filter(|l| l.attribute("effort").is_some()) {
+                Some(l) => Some(urdf_value(path, doc, l, "effort")?).filter(|e| *e > 0.0),
+                None => None,
+            };
             Joint::Hinge {
                 axis: axis.normalize(),
                 anchor: Vector3::zeros(),
                 range,
-                damping: dyn_value("damping"),
-                frictionloss: dyn_value("friction"),
+                damping: dyn_value("damping")?,
+                frictionloss: dyn_value("friction")?,
                 solreflimit: None,
+                effort_limit,
             }
         }
         other => Joint::Other(other.to_string()),
@@ -292,13 +307,14 @@ fn read_joint(
     let name = j.attribute("name").unwrap_or("").to_string();
     let kind = j.attribute("type").unwrap_or("");
     let limit = j.children().find(|n| n.has_tag_name("limit"));
-    if let Some(e) = limit
-        .and_then(|l| l.attribute("effort"))
-        .and_then(|e| e.parse::<f64>().ok())
+    let joint = joint_kind(path, doc, j, kind, limit)?;
+    if let Joint::Hinge {
+        effort_limit: Some(e),
+        ..
+    } = joint
     {
         efforts.insert(name.clone(), e);
     }
-    let joint = joint_kind(path, doc, j, kind, limit)?;
     let b = &mut bodies[child];
     if b.parent.is_some() {
         return Err(bad(
@@ -348,6 +364,55 @@ fn read_transmission(
     })
 }
 
+/// The links reordered so that every parent comes before its children (a URDF may list
+/// its links in any order; the world poses are composed parent first), with parent
+/// indices renumbered; links whose joints form a loop are refused.
+fn parents_first(path: &Path, bodies: Vec<Body>) -> Result<Vec<Body>, InteropError> {
+    let n = bodies.len();
+    let mut children = vec![Vec::new(); n];
+    let mut order: Vec<usize> = Vec::with_capacity(n);
+    for (i, b) in bodies.iter().enumerate() {
+        match b.parent {
+            Some(p) => children[p].push(i),
+            None => order.push(i),
+        }
+    }
+    // Breadth first from the roots: each link after its parent.
+    let mut k = 0;
+    while k < order.len() {
+        order.extend(children[order[k]].iter().copied());
+        k += 1;
+    }
+    if order.len() < n {
+        let mut placed = vec![false; n];
+        order.iter().for_each(|&i| placed[i] = true);
+        let looped: Vec<String> = (0..n)
+            .filter(|&i| !placed[i])
+            .map(|i| format!("`{}`", bodies[i].name))
+            .collect();
+        return Err(InteropError::Invalid {
+            file: path.display().to_string(),
+            message: format!(
+                "the joints of links {} form a loop (a URDF's links form a tree)",
+                looped.join(", ")
+            ),
+        });
+    }
+    let mut new_index = vec![0; n];
+    for (new, &old) in order.iter().enumerate() {
+        new_index[old] = new;
+    }
+    let mut slots: Vec<Option<Body>> = bodies.into_iter().map(Some).collect();
+    Ok(order
+        .iter()
+        .filter_map(|&old| slots[old].take())
+        .map(|mut b| {
+            b.parent = b.parent.map(|p| new_index[p]);
+            b
+        })
+        .collect())
+}
+
 pub(super) fn read(
     path: &Path,
     doc: &roxmltree::Document,
@@ -365,6 +430,7 @@ pub(super) fn read(
     for j in root.children().filter(|n| n.has_tag_name("joint")) {
         read_joint(path, doc, j, &index, &mut bodies, &mut efforts)?;
     }
+    let bodies = parents_first(path, bodies)?;
     let mut actuators = Vec::new();
     for t in root.children().filter(|n| n.has_tag_name("transmission")) {
         actuators.push(read_transmission(path, doc, t, &efforts)?);

@@ -407,9 +407,10 @@ fn bad_robot_files_are_refused_naming_the_file_and_what_is_missing() {
             "missing.stl",
         ),
         (
-            "box-feet.urdf",
+            // Leg `a` stands on a box (a foot); leg `b` has no collision geometry at all.
+            "no-collision.urdf",
             r#"<robot name="r"><link name="a"><inertial><mass value="1"/><inertia ixx="1" iyy="1" izz="1"/></inertial><collision><geometry><box size="0.1 0.1 0.1"/></geometry></collision></link><link name="b"><inertial><mass value="1"/><inertia ixx="1" iyy="1" izz="1"/></inertial></link><joint name="hip" type="revolute"><parent link="a"/><child link="b"/><axis xyz="0 1 0"/><limit lower="-1" upper="1" effort="1" velocity="1"/></joint></robot>"#,
-            "has no foot",
+            "leg `b` has no foot: it has no collision geometry",
         ),
         (
             "vertical.xml",
@@ -510,4 +511,355 @@ fn the_lab_mugatu_walks_on_its_crossed_feet_and_not_on_half_spheres() {
     half.geometry.foot_section_cut_over_l = Some(0.0);
     let r = simulate_walk(&half, &opts).expect("runs").report;
     assert!(!r.walks, "{r:?}");
+}
+
+/// Writes `files` (name, text) into a fresh directory, imports the first and returns the
+/// design with the TOML text.
+fn import_hand(files: &[(&str, &str)]) -> (Design, String) {
+    let dir = tempfile::tempdir().expect("tempdir");
+    for (name, text) in files {
+        std::fs::write(dir.path().join(name), text).expect("write");
+    }
+    let f = dir.path().join(files[0].0);
+    let toml = dir.path().join("out.toml");
+    run_ok(&["sim", "import", s(&f), "--out", s(&toml)]);
+    let text = std::fs::read_to_string(&toml).expect("toml");
+    (Design::from_file(&toml).expect("valid"), text)
+}
+
+fn servo_of(d: &Design) -> (f64, f64) {
+    match d.control {
+        robot_survey::sim::design::ControlSpec::ServoSine {
+            kp_over_mgl,
+            torque_limit_nm,
+            ..
+        } => (kp_over_mgl, torque_limit_nm),
+        _ => panic!("expected a servo: {:?}", d.control),
+    }
+}
+
+/// A hand-written URDF with no `<transmission>`: sphere feet on links fixed 0.3 m below the
+/// hip, the hip's `<limit effort="2">`, its `<dynamics>`; the links listed children first.
+const EFFORT_URDF: &str = r#"<?xml version="1.0"?>
+<robot name="effort">
+  <link name="swing_foot">
+    <inertial><mass value="0.1"/><inertia ixx="1e-5" iyy="1e-5" izz="1e-5"/></inertial>
+    <collision><geometry><sphere radius="0.03"/></geometry></collision>
+  </link>
+  <link name="swing">
+    <inertial><origin xyz="0 -0.05 -0.15"/><mass value="1.0"/><inertia ixx="0.01" iyy="0.01" izz="0.001"/></inertial>
+    <collision><origin xyz="0 -0.05 -0.15" rpy="1.5707963267948966 0 0"/><geometry><cylinder radius="0.01" length="0.4"/></geometry></collision>
+  </link>
+  <link name="base_foot">
+    <inertial><mass value="0.1"/><inertia ixx="1e-5" iyy="1e-5" izz="1e-5"/></inertial>
+    <collision><geometry><sphere radius="0.03"/></geometry></collision>
+  </link>
+  <link name="base">
+    <inertial><origin xyz="0 0.05 -0.15"/><mass value="1.0"/><inertia ixx="0.01" iyy="0.01" izz="0.001"/></inertial>
+  </link>
+  <joint name="base_foot_fix" type="fixed"><parent link="base"/><child link="base_foot"/><origin xyz="0 0.05 -0.3"/></joint>
+  <joint name="swing_foot_fix" type="fixed"><parent link="swing"/><child link="swing_foot"/><origin xyz="0 -0.05 -0.3"/></joint>
+  <joint name="hip" type="revolute">
+    <parent link="base"/><child link="swing"/><axis xyz="0 1 0"/>
+    <limit lower="-0.5" upper="0.6" effort="2" velocity="5"/>
+    <dynamics damping="0.02" friction="0.01"/>
+  </joint>
+</robot>
+"#;
+
+/// The hip's declared effort limit is the default servo's torque limit, read from the file.
+#[test]
+fn a_urdf_hip_effort_without_transmission_limits_the_default_servo() {
+    let (d, text) = import_hand(&[("effort.urdf", EFFORT_URDF)]);
+    assert_eq!(servo_of(&d).1, 2.0, "the hip's <limit effort=\"2\">");
+    assert!(
+        text.contains("torque_limit_nm = 2.0  # [effort.urdf sha256:")
+            && text.contains("<limit effort>"),
+        "{text}"
+    );
+}
+
+/// URDF links may come in any order: children listed before their parents read the same.
+#[test]
+fn a_urdf_listing_child_links_first_imports_to_its_hand_worked_values() {
+    let (d, _) = import_hand(&[("effort.urdf", EFFORT_URDF)]);
+    // Feet 0.3 m below the hip, radius 0.03: L = 0.33; 2 × (1.0 + 0.1) kg.
+    assert!((d.geometry.leg_length_m - 0.33).abs() < 1e-12);
+    assert!((d.mass.total_mass_kg - 2.2).abs() < 1e-12);
+    // Each leg's COM (1.0·0.15 + 0.1·0.3)/1.1 below the hip.
+    let h = 1.0 - (0.18 / 1.1) / 0.33;
+    assert!((d.mass.leg_com_height_over_l - h).abs() < 1e-12);
+    assert!((d.geometry.foot_center_lateral_over_l - 0.05 / 0.33).abs() < 1e-12);
+}
+
+/// The body's extent is exact for turned primitives: the swing leg's cylinder, 0.4 m long,
+/// rolled 90° to lie along y from −0.25 to 0.15 m (not 0.4 + 2 × its radius).
+#[test]
+fn the_body_length_is_the_exact_extent_of_a_turned_cylinder() {
+    let (d, _) = import_hand(&[("effort.urdf", EFFORT_URDF)]);
+    assert!(
+        (d.geometry.body_length_m - 0.4).abs() < 1e-12,
+        "{}",
+        d.geometry.body_length_m
+    );
+}
+
+/// A hand-written MJCF: radians with eulerseq zyx (the base turned 90° about z, so the
+/// hip axis, the body's y, lies along the world's −x), a default class as childclass,
+/// `fromto` capsules by density, ellipsoid feet turned by `xyaxes`, `<joint type="free">`,
+/// the hip's `actuatorfrcrange`, `<option timestep>`, and the actuator in an `<include>`d
+/// file (`ACTUATOR` replaced by each case's).
+const RAD_MJCF: &str = r#"<mujoco model="rad">
+  <compiler angle="radian" eulerseq="zyx"/>
+  <option timestep="0.0005"/>
+  <default>
+    <default class="leg">
+      <geom type="capsule" size="0.01" density="800"/>
+      <joint type="hinge" damping="0.01"/>
+    </default>
+  </default>
+  <worldbody>
+    <geom name="floor" type="plane" size="2 2 0.1"/>
+    <body name="base" pos="0 0 0.4" euler="1.5707963267948966 0 0" childclass="leg">
+      <joint name="root" type="free"/>
+      <geom name="base_leg" fromto="0 0.05 0  0 0.05 -0.35"/>
+      <geom name="base_foot" type="ellipsoid" pos="0 0.05 -0.35" size="0.04 0.03 0.02" xyaxes="0 1 0 -1 0 0" mass="0.05"/>
+      <body name="swing">
+        <joint name="hip" axis="0 1 0" range="-0.4 0.4" actuatorfrcrange="-1.5 1.5"/>
+        <inertial pos="0 -0.05 -0.2" mass="0.3" fullinertia="0.004 0.004 0.0002 0 0 0"/>
+        <geom name="swing_leg" fromto="0 -0.05 0  0 -0.05 -0.35"/>
+        <geom name="swing_foot" type="ellipsoid" pos="0 -0.05 -0.35" size="0.04 0.03 0.02" xyaxes="0 1 0 -1 0 0" mass="0.05"/>
+      </body>
+    </body>
+  </worldbody>
+  <include file="act.xml"/>
+</mujoco>
+"#;
+
+fn rad_with(actuator: &str) -> (Design, String) {
+    import_hand(&[
+        ("rad.xml", RAD_MJCF),
+        (
+            "act.xml",
+            &format!("<mujoco><actuator>{actuator}</actuator></mujoco>"),
+        ),
+    ])
+}
+
+#[test]
+fn a_hand_written_radian_mjcf_with_an_include_imports_to_its_hand_worked_values() {
+    let (d, _) = rad_with("");
+    // Capsule r 0.01, length 0.35, density 800; base = capsule + foot 0.05; swing 0.3.
+    let capsule =
+        800.0 * (std::f64::consts::PI * 1e-4 * 0.35 + 4.0 / 3.0 * std::f64::consts::PI * 1e-6);
+    let base = capsule + 0.05;
+    assert!((d.mass.total_mass_kg - (base + 0.3)).abs() < 1e-12);
+    // Feet 0.35 below the hip, semi z 0.02; xyaxes puts 0.04 along the body's y (the hip axis).
+    assert!((d.geometry.leg_length_m - 0.37).abs() < 1e-12);
+    assert_eq!(d.geometry.foot_semi_axes_m, [0.03, 0.04, 0.02]);
+    assert!((d.geometry.hip_half_width_over_l - 0.05 / 0.37).abs() < 1e-12);
+    let zb = (capsule * 0.175 + 0.05 * 0.35) / base;
+    let h = 1.0 - 0.5 * (zb + 0.2) / 0.37;
+    assert!((d.mass.leg_com_height_over_l - h).abs() < 1e-12);
+    assert!((d.hardstop.as_ref().expect("stop").limit_deg - 0.4f64.to_degrees()).abs() < 1e-9);
+    assert_eq!(d.numerics.time_step_s, 0.0005);
+    // No actuator: the joint's actuatorfrcrange ±1.5 N·m limits the default servo.
+    assert_eq!(servo_of(&d).1, 1.5);
+}
+
+/// MuJoCo's joint torque is gear × the actuator force: a motor's is bounded by gear ×
+/// ctrlrange (and forcerange), a position servo's stiffness is gear²·kp; a `general` with
+/// an affine bias −kp·q − kv·q̇ is a position servo; the joint's actuatorfrcrange binds
+/// when smaller.
+#[test]
+fn mjcf_actuator_gear_and_ranges_give_the_hip_torque() {
+    let torque = |d: &Design| match d.control {
+        robot_survey::sim::design::ControlSpec::BangBang { torque_nm, .. } => torque_nm,
+        _ => panic!("a motor is driven bang-bang: {:?}", d.control),
+    };
+    // gear 2 × ctrlrange 0.5 = 1 N·m (the joint's 1.5 is larger).
+    let (d, _) = rad_with(r#"<motor joint="hip" gear="2" ctrlrange="-0.5 0.5"/>"#);
+    assert_eq!(torque(&d), 1.0);
+    // gear 2 × forcerange 1 = 2 N·m, the joint's 1.5 binds.
+    let (d, _) = rad_with(r#"<motor joint="hip" gear="2" forcerange="-1 1"/>"#);
+    assert_eq!(torque(&d), 1.5);
+    let mgl = |d: &Design| d.mass.total_mass_kg * 9.81 * d.geometry.leg_length_m;
+    // kp 4 through gear 2: 16 N·m/rad; forcerange 0.5 × 2 = 1 N·m.
+    let (d, _) = rad_with(r#"<position joint="hip" kp="4" gear="2" forcerange="-0.5 0.5"/>"#);
+    let (kp, limit) = servo_of(&d);
+    assert!((kp * mgl(&d) - 16.0).abs() < 1e-9, "{kp}");
+    assert_eq!(limit, 1.0);
+    // MuJoCo Menagerie's servo: gain 3, bias (0, −3, −0.1).
+    let (d, _) = rad_with(
+        r#"<general joint="hip" gainprm="3" biastype="affine" biasprm="0 -3 -0.1" forcerange="-0.7 0.7" ctrlrange="-1 1"/>"#,
+    );
+    let (kp, limit) = servo_of(&d);
+    assert!((kp * mgl(&d) - 3.0).abs() < 1e-9, "{kp}");
+    assert_eq!(limit, 0.7);
+}
+
+#[test]
+fn more_bad_robot_files_are_refused_naming_the_file_and_the_element() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let swing = r#"<body name="s"><joint name="hip" axis="0 1 0"/><geom type="sphere" size="0.05" pos="0 -0.05 -0.3"/></body>"#;
+    let mjcf = |base_attrs: &str, geom: &str| {
+        format!(
+            r#"<mujoco><worldbody><body name="a" pos="0 0 0.35"{base_attrs}><freejoint/>{geom}{swing}</body></worldbody></mujoco>"#
+        )
+    };
+    let foot = r#"<geom type="sphere" size="0.05" pos="0 0.05 -0.3"/>"#;
+    let link = |n: &str| {
+        format!(
+            r#"<link name="{n}"><inertial><mass value="1"/><inertia ixx="1" iyy="1" izz="1"/></inertial><collision><geometry><sphere radius="0.1"/></geometry></collision></link>"#
+        )
+    };
+    let cases: Vec<(&str, String, &str)> = vec![
+        (
+            "zero-quat.xml",
+            mjcf(r#" quat="0 0 0 0""#, foot),
+            "<body>: `quat` is zero",
+        ),
+        (
+            "zero-fromto.xml",
+            mjcf(
+                "",
+                &format!(r#"{foot}<geom type="capsule" size="0.01" fromto="0 0 0 0 0 0"/>"#),
+            ),
+            "`fromto` has zero length",
+        ),
+        (
+            "negative-size.xml",
+            mjcf(
+                "",
+                r#"<geom type="sphere" size="-0.05" pos="0 0.05 -0.3"/>"#,
+            ),
+            "is negative",
+        ),
+        (
+            "missing-include.xml",
+            r#"<mujoco><include file="nope.xml"/></mujoco>"#.into(),
+            "<include>: cannot read",
+        ),
+        (
+            "loop.urdf",
+            format!(
+                r#"<robot name="r">{}{}{}<joint name="a" type="fixed"><parent link="b"/><child link="c"/></joint><joint name="b" type="fixed"><parent link="c"/><child link="b"/></joint></robot>"#,
+                link("a"),
+                link("b"),
+                link("c")
+            ),
+            "form a loop",
+        ),
+        (
+            "bad-damping.urdf",
+            format!(
+                r#"<robot name="r">{}{}<joint name="hip" type="continuous"><parent link="a"/><child link="b"/><axis xyz="0 1 0"/><dynamics damping="lots"/></joint></robot>"#,
+                link("a"),
+                link("b")
+            ),
+            "lots",
+        ),
+    ];
+    for (name, text, needle) in cases {
+        let f = dir.path().join(name);
+        std::fs::write(&f, text).expect("write");
+        let o = survey(&["sim", "import", s(&f)]);
+        let e = stderr(&o);
+        assert_eq!(o.status.code(), Some(2), "{name}: {e}");
+        assert!(e.contains(name), "{name}: the error names the file: {e}");
+        assert!(e.contains(needle), "{name}: expected `{needle}` in: {e}");
+    }
+}
+
+/// A compass-gait walker as MuJoCo users write it: each leg one capsule, `fromto` 0.3 m
+/// straight down from the hip, radius 0.02, mass from MuJoCo's default density 1000 kg/m³;
+/// the legs 0.1 m apart on the hip axis.
+const COMPASS_MJCF: &str = r#"<mujoco model="compass">
+  <worldbody>
+    <geom name="floor" type="plane" size="2 2 0.1"/>
+    <body name="left" pos="0 0.05 0.32">
+      <freejoint/>
+      <geom name="left_leg" type="capsule" fromto="0 0 0 0 0 -0.3" size="0.02"/>
+      <body name="right" pos="0 -0.1 0">
+        <joint name="hip" type="hinge" axis="0 1 0" range="-0.5 0.5"/>
+        <geom name="right_leg" type="capsule" fromto="0 0 0 0 0 -0.3" size="0.02"/>
+      </body>
+    </body>
+  </worldbody>
+</mujoco>
+"#;
+
+/// An upright capsule leg stands on the sphere of its radius about its lower end point.
+#[test]
+fn a_two_capsule_compass_walker_stands_on_its_capsule_ends() {
+    let (d, text) = import_hand(&[("compass.xml", COMPASS_MJCF)]);
+    // By hand: the hip on the capsules' upper end points; each lower end point 0.3 m below,
+    // its hemisphere reaching 0.02 lower: L = 0.32. The foot is that end's sphere: 0.02.
+    assert!((d.geometry.leg_length_m - 0.32).abs() < 1e-12, "{text}");
+    for s in d.geometry.foot_semi_axes_m {
+        assert!((s - 0.02).abs() < 1e-12, "{text}");
+    }
+    // Each capsule: a cylinder π·0.02²·0.3 plus a ball 4/3·π·0.02³, times 1000 kg/m³;
+    // its COM at its middle, 0.15 m below the hip.
+    let leg = 1000.0 * std::f64::consts::PI * (0.02f64.powi(2) * 0.3 + 4.0 / 3.0 * 0.02f64.powi(3));
+    assert!((d.mass.total_mass_kg - 2.0 * leg).abs() < 1e-12, "{text}");
+    assert!((d.mass.leg_com_height_over_l - (1.0 - 0.15 / 0.32)).abs() < 1e-12);
+    // The feet under the legs, 0.05 m either side of the hip point, straight below it.
+    assert!((d.geometry.foot_center_lateral_over_l - 0.05 / 0.32).abs() < 1e-12);
+    assert!(d.geometry.foot_center_forward_over_l.abs() < 1e-12);
+    assert!(
+        text.contains("capsule `left_leg` within 5° of vertical")
+            && text.contains("capsule `right_leg` within 5° of vertical"),
+        "{text}"
+    );
+}
+
+/// A hand-written URDF whose feet are boxes 0.1 × 0.06 × 0.02 m, their centres 0.3 m below
+/// the hip, 0.02 m ahead of it and 0.05 m to either side.
+const BOX_FEET_URDF: &str = r#"<?xml version="1.0"?>
+<robot name="box_feet">
+  <link name="left">
+    <inertial><origin xyz="0 0.05 -0.15"/><mass value="1.0"/><inertia ixx="0.01" iyy="0.01" izz="0.001"/></inertial>
+    <collision name="left_foot"><origin xyz="0.02 0.05 -0.3"/><geometry><box size="0.1 0.06 0.02"/></geometry></collision>
+  </link>
+  <link name="right">
+    <inertial><origin xyz="0 -0.05 -0.15"/><mass value="1.0"/><inertia ixx="0.01" iyy="0.01" izz="0.001"/></inertial>
+    <collision name="right_foot"><origin xyz="0.02 -0.05 -0.3"/><geometry><box size="0.1 0.06 0.02"/></geometry></collision>
+  </link>
+  <joint name="hip" type="revolute">
+    <parent link="left"/><child link="right"/><axis xyz="0 1 0"/>
+    <limit lower="-0.5" upper="0.5" effort="2" velocity="5"/>
+  </joint>
+</robot>
+"#;
+
+/// A box foot is replaced by the best-fitting ellipsoid of its corners a floor touches, set
+/// down where the box stands.
+#[test]
+fn box_feet_are_read_as_the_ellipsoid_of_their_hull_standing_where_the_box_does() {
+    let (d, text) = import_hand(&[("box_feet.urdf", BOX_FEET_URDF)]);
+    // By hand: the box's bottom face 0.3 + 0.02/2 = 0.31 m below the hip.
+    assert!(
+        (d.geometry.leg_length_m - 0.31).abs() < 1e-12,
+        "{}",
+        d.geometry.leg_length_m
+    );
+    // Any ellipsoid fitted to the box's corners lies within the sphere through all eight:
+    // no semi-axis beyond the half-diagonal √(0.05² + 0.03² + 0.01²).
+    let half_diagonal = (0.05f64.powi(2) + 0.03f64.powi(2) + 0.01f64.powi(2)).sqrt();
+    for s in d.geometry.foot_semi_axes_m {
+        assert!(
+            s.is_finite() && s > 0.0 && s <= half_diagonal,
+            "{s}: {text}"
+        );
+    }
+    // The corners are symmetric about the box's vertical centre line, so is the fit.
+    assert!((d.geometry.foot_center_forward_over_l - 0.02 / 0.31).abs() < 1e-9);
+    assert!((d.geometry.foot_center_lateral_over_l - 0.05 / 0.31).abs() < 1e-9);
+    assert!(
+        text.contains("convex-hull points of box `left_foot`")
+            && text.contains("so its lowest point is the box's")
+            && text.contains("mm as placed"),
+        "{text}"
+    );
 }
