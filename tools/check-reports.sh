@@ -58,10 +58,16 @@ for t in zippy-calibration zippy-top-speed zippy-spherical-speed; do
   contained "$T/ex-$t.md" gap-published.md
 done
 # The gap benchmark is re-scored from its points file (no case is run again): the same
-# command as the one that made it, with --merge.
+# command as the one that made it, with --merge; its exhaustively diagnosed cases are those
+# the points file's specification line names.
+EXF=()
+while IFS= read -r e; do EXF+=(--exhaustive "$e"); done < <(python3 -c '
+import json, sys
+spec = open(sys.argv[1]).readline().split(" ", 4)[4]
+print("\n".join(json.loads(spec)[1].get("exhaustive", [])))' reports/gap-benchmark.points.csv)
 "$S" gap benchmark --design mugatu --cases-from reports/gap-benchmark-rules/main.points.csv \
   --drake tests/golden/drake/gap --drake-reference tests/golden/drake/gap-lagged \
-  --drake-reference tests/golden/drake/gap-lagged-logs --drake-seeds 3 --exhaustive main/pair-expected/ \
+  --drake-reference tests/golden/drake/gap-lagged-logs --drake-seeds 3 "${EXF[@]}" \
   --compare reports/gap-benchmark-rules/main.points.csv \
   --compare reports/gap-benchmark-rules/drake-lagged.points.csv \
   --compare reports/gap-benchmark-rules/drake-lagged-logs.points.csv \
