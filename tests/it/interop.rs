@@ -377,6 +377,18 @@ fn a_hand_written_urdf_merges_fixed_links_and_reads_drake_properties() {
     );
 }
 
+/// Writes `text` as `name` in `dir` and checks that `survey sim import` refuses it (exit 2)
+/// with an error naming the file and holding `needle`.
+fn assert_import_refused(dir: &Path, name: &str, text: &str, needle: &str) {
+    let f = dir.join(name);
+    std::fs::write(&f, text).expect("write");
+    let o = survey(&["sim", "import", s(&f)]);
+    let e = stderr(&o);
+    assert_eq!(o.status.code(), Some(2), "{name}: {e}");
+    assert!(e.contains(name), "{name}: the error names the file: {e}");
+    assert!(e.contains(needle), "{name}: expected `{needle}` in: {e}");
+}
+
 #[test]
 fn bad_robot_files_are_refused_naming_the_file_and_what_is_missing() {
     let dir = tempfile::tempdir().expect("tempdir");
@@ -424,13 +436,7 @@ fn bad_robot_files_are_refused_naming_the_file_and_what_is_missing() {
         ),
     ];
     for (name, text, needle) in cases {
-        let f = dir.path().join(name);
-        std::fs::write(&f, text).expect("write");
-        let o = survey(&["sim", "import", s(&f)]);
-        let e = stderr(&o);
-        assert_eq!(o.status.code(), Some(2), "{name}: {e}");
-        assert!(e.contains(name), "{name}: the error names the file: {e}");
-        assert!(e.contains(needle), "{name}: expected `{needle}` in: {e}");
+        assert_import_refused(dir.path(), name, text, needle);
     }
 }
 
@@ -761,13 +767,7 @@ fn more_bad_robot_files_are_refused_naming_the_file_and_the_element() {
         ),
     ];
     for (name, text, needle) in cases {
-        let f = dir.path().join(name);
-        std::fs::write(&f, text).expect("write");
-        let o = survey(&["sim", "import", s(&f)]);
-        let e = stderr(&o);
-        assert_eq!(o.status.code(), Some(2), "{name}: {e}");
-        assert!(e.contains(name), "{name}: the error names the file: {e}");
-        assert!(e.contains(needle), "{name}: expected `{needle}` in: {e}");
+        assert_import_refused(dir.path(), name, &text, needle);
     }
 }
 

@@ -178,14 +178,13 @@ fn bang_bang_from_file(
             "the hip's torque actuator (driven bang-bang against the stops)",
         ),
     );
-    match limit {
-        Some((t, how)) => b.file("control.torque_nm", t, &how),
-        None => b.default(
-            "control.torque_nm",
-            defaults::BANG_BANG_TORQUE_OVER_MGL * s.mgl,
-            "the reference set's 0.66 m·g·L",
-        ),
-    }
+    torque_from(
+        b,
+        "control.torque_nm",
+        limit,
+        defaults::BANG_BANG_TORQUE_OVER_MGL * s.mgl,
+        "the reference set's 0.66 m·g·L",
+    );
     b.default("control.frequency_hz", s.f_drive, &s.why);
     if velocity_damping > 0.0 {
         let tau = b.num("control.torque_nm").unwrap_or(0.0);
@@ -232,13 +231,20 @@ fn servo_by_default(b: &mut Builder, s: &Scales, limit: Option<(f64, String)>) {
 
 /// `control.torque_limit_nm`: the file's limit, else the reference set's.
 fn servo_torque_limit(b: &mut Builder, s: &Scales, limit: Option<(f64, String)>) {
+    torque_from(
+        b,
+        "control.torque_limit_nm",
+        limit,
+        defaults::TORQUE_LIMIT_OVER_MGL * s.mgl,
+        "the reference set's 0.74 m·g·L",
+    );
+}
+
+/// A torque at `path`: the file's (with how it was read), else the reference set's `default`.
+fn torque_from(b: &mut Builder, path: &str, limit: Option<(f64, String)>, default: f64, why: &str) {
     match limit {
-        Some((t, how)) => b.file("control.torque_limit_nm", t, &how),
-        None => b.default(
-            "control.torque_limit_nm",
-            defaults::TORQUE_LIMIT_OVER_MGL * s.mgl,
-            "the reference set's 0.74 m·g·L",
-        ),
+        Some((t, how)) => b.file(path, t, &how),
+        None => b.default(path, default, why),
     }
 }
 
