@@ -49,7 +49,7 @@ pub enum SimCommand {
     /// Write a design (scaled or not) as MJCF (MuJoCo), URDF or SDF (Drake): legs, hip,
     /// feet, servo and start; what the format cannot carry goes to a sidecar TOML.
     Export(ExportArgs),
-    /// Read a two-body hip walker from MJCF or URDF as a design TOML, every value tagged
+    /// Read a two-body hip walker from MJCF, URDF or SDF as a design TOML, every value tagged
     /// with its source (the file and its sha256, --set, or the command's defaults).
     Import(ImportArgs),
     /// How fast this simulator walks a design: steps per second on one thread and on every
@@ -90,14 +90,17 @@ pub struct ExportArgs {
 #[derive(Args, Debug)]
 #[command(
     after_help = "Examples:\n  survey sim import walker.urdf --out walker.toml\n  \
-survey sim import lab/mugatu.xml --set control.amplitude_deg=35 --set control.frequency_hz=1.4 --out mugatu-lab.toml\n\n\
+survey sim import lab/mugatu.xml --set control.amplitude_deg=35 --set control.frequency_hz=1.4 --out mugatu-lab.toml\n  \
+survey sim import mugatu.sdf --sidecar mugatu.sdf.sidecar.toml --out mugatu.toml\n\n\
 The file must be two legs joined by one revolute hip, the first leg free (links fixed to a leg are \
 merged into it); anything else is refused, saying what is missing. Each leg's foot is its lowest \
 collision geometry: a sphere or ellipsoid as it is, a mesh replaced by its best-fitting ellipsoid. \
-Values the file lacks (the drive, for instance) come from --set or the defaults, tagged as such."
+Values the file lacks (the drive, for instance) come from --set or the defaults, tagged as such. \
+SDF: one <model> (or the one model of a <world>); poses relative_to a link or __model__ only; meshes \
+by a path relative to the file (model:// and package:// are refused)."
 )]
 pub struct ImportArgs {
-    /// The robot file: MJCF (.xml) or URDF (.urdf).
+    /// The robot file: MJCF (.xml), URDF (.urdf) or SDFormat 1.5–1.11 (.sdf).
     pub file: PathBuf,
     /// Write the design TOML here (default: print it).
     #[arg(long, value_name = "FILE")]

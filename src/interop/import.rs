@@ -1,4 +1,4 @@
-//! A two-body hip walker read from MJCF or URDF, as a design TOML whose every value says where
+//! A two-body hip walker read from MJCF, URDF or SDFormat, as a design TOML whose every value says where
 //! it came from: the file (with its sha256), the file's `<custom>` data or a sidecar, the
 //! command line (`--set`), or the command's defaults.
 //!
@@ -27,7 +27,7 @@ use super::legs::{LegRead, read_legs, topo, world_frames};
 use super::robot_file::{RobotFile, Shape, read_text};
 use super::soft_contact::pressure_field_of;
 use super::{CUSTOM_PREFIX, InteropError};
-use super::{mjcf, urdf};
+use super::{mjcf, sdf, urdf};
 use crate::sim::walk::stable_time_step_s;
 use crate::sim::{Design, EffectSpec, GRAVITY_MPS2};
 
@@ -74,7 +74,8 @@ pub struct Imported {
     pub design: Design,
 }
 
-/// Reads an MJCF (`.xml`, root `<mujoco>`) or URDF (root `<robot>`) file.
+/// Reads an MJCF (`.xml`, root `<mujoco>`), URDF (root `<robot>`) or SDFormat (root `<sdf>`)
+/// file.
 pub fn read_robot_file(path: &Path) -> Result<RobotFile, InteropError> {
     let (text, sha) = read_text(path)?;
     let doc = roxmltree::Document::parse(&text).map_err(|e| InteropError::Invalid {
@@ -85,14 +86,11 @@ pub fn read_robot_file(path: &Path) -> Result<RobotFile, InteropError> {
     match root.tag_name().name() {
         "mujoco" => mjcf::read(path, &doc, sha),
         "robot" => urdf::read(path, &doc, sha),
-        "sdf" => Err(InteropError::Invalid {
-            file: path.display().to_string(),
-            message: "SDFormat import is not supported: give the walker as URDF or MJCF".into(),
-        }),
+        "sdf" => sdf::read(path, &doc, sha),
         other => Err(InteropError::Invalid {
             file: path.display().to_string(),
             message: format!(
-                "root element <{other}> is neither <mujoco> (MJCF) nor <robot> (URDF)"
+                "root element <{other}> is none of <mujoco> (MJCF), <robot> (URDF), <sdf> (SDFormat)"
             ),
         }),
     }

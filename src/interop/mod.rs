@@ -1,11 +1,11 @@
 //! Walker designs in the formats roboticists use. A design (scaled or not) is exported as
 //! MJCF (MuJoCo), URDF or SDF (Drake's extensions); a two-body hip walker is imported from
-//! MJCF or URDF as a design TOML whose every value names its source.
+//! MJCF, URDF or SDF as a design TOML whose every value names its source.
 //!
 //! * [`export`]: the legs, hip, feet, servo and start of a design in each format, and what a
 //!   format cannot carry (MJCF `<custom>` data, a sidecar TOML).
 //! * [`import`]: a robot file's two legs, hip and feet as the design's symmetric model.
-//! * [`robot_file`]: MJCF and URDF read into one neutral form.
+//! * [`robot_file`]: MJCF, URDF and SDFormat read into one neutral form.
 //! * [`soft_contact`]: the closest MuJoCo soft contact to the pressure field, and back.
 //! * [`mesh`]: STL meshes, their mass properties, the best-fitting ellipsoid of a foot.
 //!
@@ -17,6 +17,7 @@ mod legs;
 pub mod mesh;
 mod mjcf;
 pub mod robot_file;
+mod sdf;
 pub mod soft_contact;
 mod urdf;
 mod xml;

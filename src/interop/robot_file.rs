@@ -1,5 +1,5 @@
 //! A robot file read into one neutral form (bodies, joints, inertials, collision geometry,
-//! actuators): MJCF (MuJoCo) and URDF (with Drake's extensions). The walker import
+//! actuators): MJCF (MuJoCo), URDF and SDFormat (with Drake's extensions). The walker import
 //! (`import.rs`) works on this form whatever the format.
 
 use std::collections::BTreeMap;

@@ -134,11 +134,6 @@ fn export_then_import_gives_the_design_back_in_every_format() {
                 ]);
             }
             run_ok(&args);
-            if ext == "sdf" {
-                // SDF is written for Drake, not read back (the import reads MJCF and URDF).
-                assert!(std::fs::read_to_string(&out).expect("sdf").contains("<sdf"));
-                continue;
-            }
             let toml = out.with_extension(format!("{ext}.toml"));
             let sidecar = PathBuf::from(format!("{}.sidecar.toml", out.display()));
             let mut args = vec![
@@ -150,7 +145,7 @@ fn export_then_import_gives_the_design_back_in_every_format() {
                 "--name",
                 &expected.name,
             ];
-            if ext == "urdf" {
+            if ext != "xml" {
                 args.extend(["--sidecar", s(&sidecar)]);
             }
             run_ok(&args);
@@ -862,4 +857,256 @@ fn box_feet_are_read_as_the_ellipsoid_of_their_hull_standing_where_the_box_does(
             && text.contains("mm as placed"),
         "{text}"
     );
+}
+
+/// A hand-written SDFormat 1.9 walker: two legs of a 1.0 kg shin link and a 0.1 kg foot link
+/// (welded), placed with `relative_to` (the swing leg turned half a turn about z relative to
+/// the base, its foot relative to it, the swing foot's collision relative to `__model__`), a
+/// shin cylinder rolled 90° (once in degrees) to lie along y, sphere feet, and a revolute hip
+/// whose axis is expressed in `__model__` and whose `<limit><effort>` is 2 N·m. No gains: the
+/// servo is the default one, limited by the effort.
+const HAND_SDF: &str = r#"<?xml version="1.0"?>
+<sdf version="1.9">
+  <model name="hand">
+    <pose>0.2 -0.1 0.4 0 0 0.5</pose>
+    <link name="base">
+      <pose relative_to="__model__">0 0 0.33 0 0 0</pose>
+      <inertial>
+        <pose>0 0.05 -0.15 0 0 0</pose>
+        <mass>1.0</mass>
+        <inertia><ixx>0.01</ixx><iyy>0.01</iyy><izz>0.001</izz></inertia>
+      </inertial>
+      <collision name="base_shin">
+        <pose degrees="true">0 0.05 -0.15 90 0 0</pose>
+        <geometry><cylinder><radius>0.01</radius><length>0.4</length></cylinder></geometry>
+      </collision>
+    </link>
+    <link name="base_foot">
+      <pose relative_to="base">0 0.05 -0.3 0 0 0</pose>
+      <inertial><mass>0.1</mass><inertia><ixx>1e-5</ixx><iyy>1e-5</iyy><izz>1e-5</izz></inertia></inertial>
+      <collision name="base_sole"><geometry><sphere><radius>0.03</radius></sphere></geometry></collision>
+    </link>
+    <link name="swing">
+      <pose relative_to="base">0 0 0 0 0 3.141592653589793</pose>
+      <inertial>
+        <pose>0 0.05 -0.15 0 0 0</pose>
+        <mass>1.0</mass>
+        <inertia><ixx>0.01</ixx><iyy>0.01</iyy><izz>0.001</izz></inertia>
+      </inertial>
+      <collision name="swing_shin">
+        <pose>0 0.05 -0.15 1.5707963267948966 0 0</pose>
+        <geometry><cylinder><radius>0.01</radius><length>0.4</length></cylinder></geometry>
+      </collision>
+    </link>
+    <link name="swing_foot">
+      <pose relative_to="swing">0 0.05 -0.3 0 0 0</pose>
+      <inertial><mass>0.1</mass><inertia><ixx>1e-5</ixx><iyy>1e-5</iyy><izz>1e-5</izz></inertia></inertial>
+      <collision name="swing_sole">
+        <pose relative_to="__model__">0 -0.05 0.03 0 0 0</pose>
+        <geometry><sphere><radius>0.03</radius></sphere></geometry>
+      </collision>
+    </link>
+    <joint name="base_foot_fix" type="fixed"><parent>base</parent><child>base_foot</child></joint>
+    <joint name="swing_foot_fix" type="fixed"><parent>swing</parent><child>swing_foot</child></joint>
+    <joint name="hip" type="revolute">
+      <pose relative_to="base">0 0 0 0 0 0</pose>
+      <parent>base</parent>
+      <child>swing</child>
+      <axis>
+        <xyz expressed_in="__model__">0 1 0</xyz>
+        <limit><lower>-0.5</lower><upper>0.6</upper><effort>2</effort></limit>
+        <dynamics><damping>0.02</damping><friction>0.01</friction></dynamics>
+      </axis>
+    </joint>
+  </model>
+</sdf>
+"#;
+
+/// A walker as Gazebo writes SDFormat 1.6: every pose with an empty `frame=''` (the default
+/// frame), both links at the model's origin, the axis in the joint frame.
+const GAZEBO_SDF: &str = r#"<?xml version="1.0"?>
+<sdf version="1.6">
+  <model name="gz_walker">
+    <pose frame=''>0 0 0.33 0 -0 0</pose>
+    <link name="base">
+      <pose frame=''>0 0 0 0 -0 0</pose>
+      <inertial>
+        <pose frame=''>0 0.05 -0.15 0 -0 0</pose>
+        <mass>1.0</mass>
+        <inertia><ixx>0.01</ixx><ixy>0</ixy><ixz>0</ixz><iyy>0.01</iyy><iyz>0</iyz><izz>0.001</izz></inertia>
+      </inertial>
+      <collision name="base_foot">
+        <pose frame=''>0 0.05 -0.3 0 -0 0</pose>
+        <geometry><sphere><radius>0.03</radius></sphere></geometry>
+      </collision>
+    </link>
+    <link name="swing">
+      <pose frame=''>0 0 0 0 -0 0</pose>
+      <inertial>
+        <pose frame=''>0 -0.05 -0.15 0 -0 0</pose>
+        <mass>1.0</mass>
+        <inertia><ixx>0.01</ixx><ixy>0</ixy><ixz>0</ixz><iyy>0.01</iyy><iyz>0</iyz><izz>0.001</izz></inertia>
+      </inertial>
+      <collision name="swing_foot">
+        <pose frame=''>0 -0.05 -0.3 0 -0 0</pose>
+        <geometry><sphere><radius>0.03</radius></sphere></geometry>
+      </collision>
+    </link>
+    <joint name="hip" type="revolute">
+      <parent>base</parent>
+      <child>swing</child>
+      <axis>
+        <xyz>0 1 0</xyz>
+        <limit><lower>-0.5</lower><upper>0.5</upper><effort>1.5</effort><velocity>10</velocity></limit>
+        <dynamics><damping>0.01</damping><friction>0</friction><spring_reference>0</spring_reference><spring_stiffness>0</spring_stiffness></dynamics>
+        <use_parent_model_frame>0</use_parent_model_frame>
+      </axis>
+    </joint>
+  </model>
+</sdf>
+"#;
+
+#[test]
+fn a_gazebo_style_sdf_with_empty_frame_attributes_imports() {
+    let (d, _) = import_hand(&[("gz.sdf", GAZEBO_SDF)]);
+    // Both sphere feet (r = 0.03) centred 0.3 below the hip at the links' common origin:
+    // L = 0.33; the legs' COMs 0.15 below it; 2 × 1.0 kg; the feet at y = ±0.05.
+    assert!((d.geometry.leg_length_m - 0.33).abs() < 1e-12);
+    assert!((d.mass.total_mass_kg - 2.0).abs() < 1e-12);
+    assert!((d.mass.leg_com_height_over_l - (1.0 - 0.15 / 0.33)).abs() < 1e-12);
+    assert!((d.geometry.foot_center_lateral_over_l - 0.05 / 0.33).abs() < 1e-12);
+    // The hip's `<effort>1.5</effort>`.
+    assert_eq!(servo_of(&d).1, 1.5);
+}
+
+#[test]
+fn a_hand_written_sdf_imports_to_its_hand_worked_values() {
+    let (d, text) = import_hand(&[("hand.sdf", HAND_SDF)]);
+    // In the model frame the hip (the base's origin, where the joint sits) is at z = 0.33; the
+    // base foot link at base + (0, 0.05, −0.3); the swing leg is the base turned by π about z,
+    // so its foot link at base + Rz(π)·(0, 0.05, −0.3) = (0, −0.05, 0.03), where its sphere's
+    // `__model__` pose puts the collision too. Both spheres (r = 0.03) are centred 0.3 below
+    // the hip: L = 0.3 + 0.03 = 0.33 (had the 90° rolls been ignored, the 0.4 m shins would
+    // reach 0.15 + 0.2 = 0.35 below the hip and be the feet).
+    assert!(
+        (d.geometry.leg_length_m - 0.33).abs() < 1e-12,
+        "{}",
+        d.geometry.leg_length_m
+    );
+    // 2 × (1.0 kg shin + 0.1 kg foot).
+    assert!((d.mass.total_mass_kg - 2.2).abs() < 1e-12);
+    // Each leg's COM (1.0 · 0.15 + 0.1 · 0.3) / 1.1 below the hip, over L.
+    let h = 1.0 - (0.18 / 1.1) / 0.33;
+    assert!(
+        (d.mass.leg_com_height_over_l - h).abs() < 1e-12,
+        "{}",
+        d.mass.leg_com_height_over_l
+    );
+    // The feet at y = ±0.05 (the swing one mirrored by the half turn).
+    assert!((d.geometry.foot_center_lateral_over_l - 0.05 / 0.33).abs() < 1e-12);
+    assert_eq!(d.geometry.foot_semi_axes_m, [0.03, 0.03, 0.03]);
+    // The hip's `<limit><effort>2</effort>`; its range's smaller side 0.5 rad.
+    assert_eq!(servo_of(&d).1, 2.0);
+    assert!(
+        text.contains("torque_limit_nm = 2.0  # [hand.sdf sha256:")
+            && text.contains("<limit><effort>"),
+        "{text}"
+    );
+    assert!((d.hardstop.as_ref().expect("stop").limit_deg - 0.5f64.to_degrees()).abs() < 1e-9);
+    assert!(text.contains("(SDF file)"), "{text}");
+}
+
+/// The same walker inside a `<world>`, the hip at its default pose (the child link's frame)
+/// with its axis in that frame (the swing link's, turned by π: its −y is the model's +y) and the swing foot's collision relative to
+/// its link, imports to the same values.
+#[test]
+fn an_sdf_world_with_one_model_and_the_axis_in_the_joint_frame_reads_the_same() {
+    let text = HAND_SDF
+        .replace(
+            r#"<sdf version="1.9">"#,
+            r#"<sdf version="1.9"><world name="w">"#,
+        )
+        .replace("</sdf>", "</world></sdf>")
+        .replace(
+            r#"<xyz expressed_in="__model__">0 1 0</xyz>"#,
+            "<xyz>0 -1 0</xyz>",
+        )
+        .replace(
+            "<pose relative_to=\"base\">0 0 0 0 0 0</pose>\n      <parent>",
+            "<parent>",
+        )
+        .replace(
+            r#"<pose relative_to="__model__">0 -0.05 0.03 0 0 0</pose>"#,
+            "<pose>0 0 0 0 0 0</pose>",
+        );
+    for gone in [
+        "expressed_in",
+        "relative_to=\"base\">0 0 0 0 0 0",
+        "0 -0.05 0.03",
+    ] {
+        assert!(!text.contains(gone), "the variant drops `{gone}`");
+    }
+    let (d, _) = import_hand(&[("world.sdf", &text)]);
+    let (a, _) = import_hand(&[("hand.sdf", HAND_SDF)]);
+    assert_same(&a, &d, 1e-12, "world.sdf against hand.sdf");
+}
+
+#[test]
+fn bad_sdf_files_are_refused_naming_the_file_and_the_element() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let mesh_foot = HAND_SDF.replace(
+        "<geometry><sphere><radius>0.03</radius></sphere></geometry></collision>\n    </link>\n    <link name=\"swing\">",
+        "<geometry><mesh><uri>model://walker/foot.stl</uri></mesh></geometry></collision>\n    </link>\n    <link name=\"swing\">",
+    );
+    assert_ne!(mesh_foot, HAND_SDF);
+    let cases: Vec<(&str, String, &str)> = vec![
+        (
+            // Line 6: the base link's pose.
+            "unknown-frame.sdf",
+            HAND_SDF.replace(
+                r#"relative_to="__model__">0 0 0.33"#,
+                r#"relative_to="hip">0 0 0.33"#,
+            ),
+            "unknown-frame.sdf:6: <pose>: relative_to=\"hip\" is not a link of this model: only a link of this model or `__model__` is supported",
+        ),
+        (
+            // Line 20: the base foot's collision.
+            "model-uri.sdf",
+            mesh_foot,
+            "model-uri.sdf:20: <uri>: mesh `model://walker/foot.stl`: model://, package:// and other URIs are not resolved",
+        ),
+        (
+            "frame.sdf",
+            HAND_SDF.replace(
+                "<link name=\"base\">",
+                "<frame name=\"f\"/><link name=\"base\">",
+            ),
+            "<frame>: <frame> in a model is not read",
+        ),
+        (
+            "world-joint.sdf",
+            HAND_SDF.replace(
+                "<parent>base</parent>\n      <child>swing</child>",
+                "<parent>world</parent>\n      <child>swing</child>",
+            ),
+            "<parent>: the joint fixes the model to the world",
+        ),
+        (
+            "old.sdf",
+            HAND_SDF.replace(r#"version="1.9""#, r#"version="1.4""#),
+            "SDFormat 1.5 to 1.11 is read",
+        ),
+        (
+            "pose-loop.sdf",
+            HAND_SDF.replace(
+                r#"relative_to="__model__">0 0 0.33"#,
+                r#"relative_to="swing">0 0 0.33"#,
+            ),
+            "relative to each other in a loop",
+        ),
+    ];
+    for (name, text, needle) in cases {
+        assert_ne!(text, HAND_SDF, "{name}: the case changes the file");
+        assert_import_refused(dir.path(), name, &text, needle);
+    }
 }

@@ -76,10 +76,10 @@ pub(super) fn control(
         Some(Joint::Hinge { effort_limit, .. }) => *effort_limit,
         _ => None,
     };
-    let joint_how = if f.format == "URDF" {
-        "the hip joint's `<limit effort>`"
-    } else {
-        "the hip joint's `actuatorfrcrange`"
+    let joint_how = match f.format {
+        "URDF" => "the hip joint's `<limit effort>`",
+        "SDF" => "the hip joint's `<limit><effort>`",
+        _ => "the hip joint's `actuatorfrcrange`",
     };
     // The torque the hip gets: the actuator's limit and the joint's, the smaller binding.
     let limit = |actuator: Option<f64>| -> Option<(f64, String)> {
