@@ -110,6 +110,20 @@ pub struct Body {
 }
 
 impl Body {
+    /// A link as a URDF or SDF file states it, before a joint hangs it on its parent: free,
+    /// at the origin, with its inertial and collisions.
+    pub fn link(name: &str, inertial: MassProps, geoms: Vec<Geom>) -> Body {
+        Body {
+            name: name.to_string(),
+            parent: None,
+            frame: Frame::IDENTITY,
+            joint: Joint::Free,
+            joint_name: String::new(),
+            inertial: Some(inertial),
+            geoms,
+        }
+    }
+
     /// The body's mass properties in its frame.
     pub fn mass_props(&self) -> MassProps {
         self.inertial.unwrap_or_else(|| {
@@ -277,4 +291,49 @@ pub(super) fn shape_mass(shape: &Shape, mass: Option<f64>, density: f64) -> Opti
         com_m: com,
         inertia_com_kgm2: unit * m,
     })
+}
+
+/// The links reordered so that every parent comes before its children (a file may list its
+/// links in any order; world poses are composed parent first), with parent indices
+/// renumbered; links whose joints form a loop are refused (`whose`: the format, for the
+/// message, e.g. "a URDF's").
+pub(super) fn parents_first(
+    path: &Path,
+    bodies: Vec<Body>,
+    whose: &str,
+) -> Result<Vec<Body>, InteropError> {
+    let n = bodies.len();
+    let mut order: Vec<usize> = (0..n).filter(|&i| bodies[i].parent.is_none()).collect();
+    let mut k = 0;
+    while k < order.len() {
+        let p = order[k];
+        order.extend((0..n).filter(|&i| bodies[i].parent == Some(p)));
+        k += 1;
+    }
+    if order.len() < n {
+        let looped: Vec<String> = (0..n)
+            .filter(|i| !order.contains(i))
+            .map(|i| format!("`{}`", bodies[i].name))
+            .collect();
+        return Err(InteropError::Invalid {
+            file: path.display().to_string(),
+            message: format!(
+                "the joints of links {} form a loop ({whose} links form a tree)",
+                looped.join(", ")
+            ),
+        });
+    }
+    let mut new_index = vec![0; n];
+    for (new, &old) in order.iter().enumerate() {
+        new_index[old] = new;
+    }
+    let mut slots: Vec<Option<Body>> = bodies.into_iter().map(Some).collect();
+    Ok(order
+        .iter()
+        .filter_map(|&old| slots[old].take())
+        .map(|mut b| {
+            b.parent = b.parent.map(|p| new_index[p]);
+            b
+        })
+        .collect())
 }

@@ -20,8 +20,8 @@ use roxmltree::{Document, Node};
 use super::InteropError;
 use super::mesh::{MassProps, read_mesh};
 use super::robot_file::{
-    Actuator, Body, ContactValues, Frame, Geom, Joint, RobotFile, Shape, bad, parse_floats, rpy,
-    vec3,
+    Actuator, Body, ContactValues, Frame, Geom, Joint, RobotFile, Shape, bad, parents_first,
+    parse_floats, rpy, vec3,
 };
 
 /// What the reader says it supports when a frame reference is not one of them.
@@ -317,15 +317,7 @@ impl<'a, 'i> Sdf<'a, 'i> {
                 values: self.contact_values(c)?,
             });
         }
-        Ok(Body {
-            name: name.to_string(),
-            parent: None,
-            frame: Frame::IDENTITY,
-            joint: Joint::Free,
-            joint_name: String::new(),
-            inertial: Some(self.inertial(l, name)?),
-            geoms,
-        })
+        Ok(Body::link(name, self.inertial(l, name)?, geoms))
     }
 }
 
@@ -473,45 +465,6 @@ impl<'a, 'i> Sdf<'a, 'i> {
             gains,
         })
     }
-}
-
-/// The links reordered so that every parent comes before its children, with parent
-/// indices renumbered; links whose joints form a loop are refused.
-fn parents_first(path: &Path, bodies: Vec<Body>) -> Result<Vec<Body>, InteropError> {
-    let n = bodies.len();
-    let mut order: Vec<usize> = (0..n).filter(|&i| bodies[i].parent.is_none()).collect();
-    let mut k = 0;
-    while k < order.len() {
-        let p = order[k];
-        order.extend((0..n).filter(|&i| bodies[i].parent == Some(p)));
-        k += 1;
-    }
-    if order.len() < n {
-        let looped: Vec<String> = (0..n)
-            .filter(|i| !order.contains(i))
-            .map(|i| format!("`{}`", bodies[i].name))
-            .collect();
-        return Err(InteropError::Invalid {
-            file: path.display().to_string(),
-            message: format!(
-                "the joints of links {} form a loop (an SDFormat model's links form a tree)",
-                looped.join(", ")
-            ),
-        });
-    }
-    let mut new_index = vec![0; n];
-    for (new, &old) in order.iter().enumerate() {
-        new_index[old] = new;
-    }
-    let mut slots: Vec<Option<Body>> = bodies.into_iter().map(Some).collect();
-    Ok(order
-        .iter()
-        .filter_map(|&old| slots[old].take())
-        .map(|mut b| {
-            b.parent = b.parent.map(|p| new_index[p]);
-            b
-        })
-        .collect())
 }
 
 /// The `<model>` of the file: under `<sdf>`, or the only one of its `<world>`; with the
@@ -666,7 +619,7 @@ pub(super) fn read(path: &Path, doc: &Document, sha: String) -> Result<RobotFile
         sha256: sha,
         includes: Vec::new(),
         format: "SDF",
-        bodies: parents_first(path, bodies)?,
+        bodies: parents_first(path, bodies, "an SDFormat model's")?,
         world_geoms: Vec::new(),
         actuators,
         gravity: gravity

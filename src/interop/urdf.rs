@@ -12,8 +12,8 @@ use roxmltree::Node;
 use super::InteropError;
 use super::mesh::{MassProps, read_mesh};
 use super::robot_file::{
-    Actuator, Body, ContactValues, Frame, Geom, Joint, RobotFile, Shape, bad, parse_floats, rpy,
-    vec3,
+    Actuator, Body, ContactValues, Frame, Geom, Joint, RobotFile, Shape, bad, parents_first,
+    parse_floats, rpy, vec3,
 };
 
 /// A URDF `<origin xyz rpy>` (absent: identity).
@@ -209,15 +209,7 @@ fn read_link(path: &Path, doc: &roxmltree::Document, l: Node) -> Result<Body, In
             values: drake_values(c),
         });
     }
-    Ok(Body {
-        name: name.to_string(),
-        parent: None,
-        frame: Frame::IDENTITY,
-        joint: Joint::Free,
-        joint_name: String::new(),
-        inertial: Some(inertial.unwrap_or(MassProps::ZERO)),
-        geoms,
-    })
+    Ok(Body::link(name, inertial.unwrap_or(MassProps::ZERO), geoms))
 }
 
 /// A joint's kind: fixed (a weld), floating, revolute or continuous (a hinge with its axis,
@@ -364,55 +356,6 @@ fn read_transmission(
     })
 }
 
-/// The links reordered so that every parent comes before its children (a URDF may list
-/// its links in any order; the world poses are composed parent first), with parent
-/// indices renumbered; links whose joints form a loop are refused.
-fn parents_first(path: &Path, bodies: Vec<Body>) -> Result<Vec<Body>, InteropError> {
-    let n = bodies.len();
-    let mut children = vec![Vec::new(); n];
-    let mut order: Vec<usize> = Vec::with_capacity(n);
-    for (i, b) in bodies.iter().enumerate() {
-        match b.parent {
-            Some(p) => children[p].push(i),
-            None => order.push(i),
-        }
-    }
-    // Breadth first from the roots: each link after its parent.
-    let mut k = 0;
-    while k < order.len() {
-        order.extend(children[order[k]].iter().copied());
-        k += 1;
-    }
-    if order.len() < n {
-        let mut placed = vec![false; n];
-        order.iter().for_each(|&i| placed[i] = true);
-        let looped: Vec<String> = (0..n)
-            .filter(|&i| !placed[i])
-            .map(|i| format!("`{}`", bodies[i].name))
-            .collect();
-        return Err(InteropError::Invalid {
-            file: path.display().to_string(),
-            message: format!(
-                "the joints of links {} form a loop (a URDF's links form a tree)",
-                looped.join(", ")
-            ),
-        });
-    }
-    let mut new_index = vec![0; n];
-    for (new, &old) in order.iter().enumerate() {
-        new_index[old] = new;
-    }
-    let mut slots: Vec<Option<Body>> = bodies.into_iter().map(Some).collect();
-    Ok(order
-        .iter()
-        .filter_map(|&old| slots[old].take())
-        .map(|mut b| {
-            b.parent = b.parent.map(|p| new_index[p]);
-            b
-        })
-        .collect())
-}
-
 pub(super) fn read(
     path: &Path,
     doc: &roxmltree::Document,
@@ -430,7 +373,7 @@ pub(super) fn read(
     for j in root.children().filter(|n| n.has_tag_name("joint")) {
         read_joint(path, doc, j, &index, &mut bodies, &mut efforts)?;
     }
-    let bodies = parents_first(path, bodies)?;
+    let bodies = parents_first(path, bodies, "a URDF's")?;
     let mut actuators = Vec::new();
     for t in root.children().filter(|n| n.has_tag_name("transmission")) {
         actuators.push(read_transmission(path, doc, t, &efforts)?);
