@@ -94,7 +94,8 @@ survey sim import lab/mugatu.xml --set control.amplitude_deg=35 --set control.fr
 survey sim import mugatu.sdf --sidecar mugatu.sdf.sidecar.toml --out mugatu.toml\n\n\
 The file must be two legs joined by one revolute hip, the first leg free (links fixed to a leg are \
 merged into it); anything else is refused, saying what is missing. Each leg's foot is its lowest \
-collision geometry: a sphere or ellipsoid as it is, a mesh replaced by its best-fitting ellipsoid. \
+collision geometry: a sphere or ellipsoid as it is, an upright capsule as the sphere of its lower \
+end, a mesh, box, cylinder or tilted capsule replaced by the best-fitting ellipsoid of its hull. \
 Values the file lacks (the drive, for instance) come from --set or the defaults, tagged as such. \
 SDF: one <model> (or the one model of a <world>); poses relative_to a link or __model__ only; meshes \
 by a path relative to the file (model:// and package:// are refused)."

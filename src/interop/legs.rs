@@ -192,10 +192,10 @@ fn walker_frame(
     })
 }
 
-/// A geometry's surface in the walker's frame, for the fit: a sphere's or ellipsoid's as a
-/// mesh, a mesh as it is, a box's, cylinder's or capsule's surface points (no triangles:
-/// only the hull's support points are used). None for a plane.
-fn geom_points(g: &Geom, to_walker: &Frame) -> Option<TriMesh> {
+/// A geometry's surface at `fr` (its frame in the walker's), for the fit: a sphere's or
+/// ellipsoid's as a mesh, a mesh as it is, a box's, cylinder's or capsule's surface points
+/// (no triangles: only the hull's support points are used). None for a plane.
+fn geom_points(g: &Geom, fr: &Frame) -> Option<TriMesh> {
     let whole =
         |semi: Vector3<f64>| ellipsoid_section(&Vector3::zeros(), &semi, 1.0, -semi.y * 2.0);
     let m = match &g.shape {
@@ -207,7 +207,6 @@ fn geom_points(g: &Geom, to_walker: &Frame) -> Option<TriMesh> {
             triangles: Vec::new(),
         },
     };
-    let fr = to_walker.then(&g.frame);
     Some(m.transformed(&fr.r, &fr.p))
 }
 
@@ -241,7 +240,7 @@ fn lowest_geom<'a>(
     let mut best: Option<(f64, &Geom, Frame, TriMesh)> = None;
     for (g, to_w) in geoms.iter().filter(|(g, _)| g.contact) {
         let fr = to_w.then(&g.frame);
-        let (Some(m), Some(low)) = (geom_points(g, to_w), foot_shapes::lowest_z(&g.shape, &fr))
+        let (Some(m), Some(low)) = (geom_points(g, &fr), foot_shapes::lowest_z(&g.shape, &fr))
         else {
             continue;
         };

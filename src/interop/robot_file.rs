@@ -32,6 +32,15 @@ impl Frame {
             p: self.r * child.p + self.p,
         }
     }
+
+    /// The parent's frame in this one.
+    pub fn inverse(&self) -> Frame {
+        let rt = self.r.transpose();
+        Frame {
+            r: rt,
+            p: -(rt * self.p),
+        }
+    }
 }
 
 /// A collision or mass geometry's shape (sizes in metres).
@@ -204,6 +213,24 @@ pub(super) fn bad(
         file: format!("{}:{}", path.display(), pos.row),
         message: format!("<{}>: {message}", node.tag_name().name()),
     }
+}
+
+/// Attribute `key` of element `n` as a finite number (an error naming the file and the
+/// element when it is missing or not a number).
+pub(super) fn attr_number(
+    path: &Path,
+    doc: &roxmltree::Document,
+    n: Node,
+    key: &str,
+) -> Result<f64, InteropError> {
+    let v = n
+        .attribute(key)
+        .ok_or_else(|| bad(path, doc, n, format!("no `{key}`")))?;
+    v.trim()
+        .parse::<f64>()
+        .ok()
+        .filter(|x| x.is_finite())
+        .ok_or_else(|| bad(path, doc, n, format!("`{key}` = \"{v}\" is not a number")))
 }
 
 pub(super) fn parse_floats(s: &str) -> Option<Vec<f64>> {

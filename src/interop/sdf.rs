@@ -20,21 +20,12 @@ use roxmltree::{Document, Node};
 use super::InteropError;
 use super::mesh::{MassProps, read_mesh};
 use super::robot_file::{
-    Actuator, Body, ContactValues, Frame, Geom, Joint, RobotFile, Shape, bad, parents_first,
-    parse_floats, rpy, vec3,
+    Actuator, Body, ContactValues, Frame, Geom, Joint, RobotFile, Shape, attr_number, bad,
+    parents_first, parse_floats, rpy, vec3,
 };
 
 /// What the reader says it supports when a frame reference is not one of them.
 const FRAMES_READ: &str = "only a link of this model or `__model__` is supported (not joint frames, <frame> elements or nested models)";
-
-/// A frame's inverse.
-fn inverse(f: &Frame) -> Frame {
-    let rt = f.r.transpose();
-    Frame {
-        r: rt,
-        p: -(rt * f.p),
-    }
-}
 
 /// The first child element whose local name is `tag` (Drake's `drake:` ones included).
 fn child<'a, 'i>(n: Node<'a, 'i>, tag: &str) -> Option<Node<'a, 'i>> {
@@ -175,7 +166,7 @@ impl<'a, 'i> Sdf<'a, 'i> {
             Some((_, r)) if r == link => Ok(pose),
             Some((p, r)) => {
                 let x_mr = self.frame_in_model(p, r, &mut Vec::new())?;
-                Ok(inverse(&self.link_in_model(link)?).then(&x_mr.then(&pose)))
+                Ok(self.link_in_model(link)?.inverse().then(&x_mr.then(&pose)))
             }
         }
     }
@@ -444,17 +435,10 @@ impl<'a, 'i> Sdf<'a, 'i> {
             .children()
             .find(|n| n.tag_name().name() == "controller_gains")
         {
-            Some(g) => {
-                let v = |k: &str| {
-                    let s = g.attribute(k).unwrap_or("");
-                    s.trim()
-                        .parse::<f64>()
-                        .ok()
-                        .filter(|x| x.is_finite())
-                        .ok_or_else(|| self.err(g, format!("`{k}` = \"{s}\" is not a number")))
-                };
-                Some((v("p")?, v("d")?))
-            }
+            Some(g) => Some((
+                attr_number(self.path, self.doc, g, "p")?,
+                attr_number(self.path, self.doc, g, "d")?,
+            )),
             None => None,
         };
         Ok(JointRead {
@@ -611,7 +595,7 @@ pub(super) fn read(path: &Path, doc: &Document, sha: String) -> Result<RobotFile
     for (i, b) in bodies.iter_mut().enumerate() {
         b.frame = match b.parent {
             None => x_wm.then(&x_ml[i]),
-            Some(p) => inverse(&x_ml[p]).then(&x_ml[i]),
+            Some(p) => x_ml[p].inverse().then(&x_ml[i]),
         };
     }
     Ok(RobotFile {

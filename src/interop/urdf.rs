@@ -12,8 +12,8 @@ use roxmltree::Node;
 use super::InteropError;
 use super::mesh::{MassProps, read_mesh};
 use super::robot_file::{
-    Actuator, Body, ContactValues, Frame, Geom, Joint, RobotFile, Shape, bad, parents_first,
-    parse_floats, rpy, vec3,
+    Actuator, Body, ContactValues, Frame, Geom, Joint, RobotFile, Shape, attr_number, bad,
+    parents_first, parse_floats, rpy, vec3,
 };
 
 /// A URDF `<origin xyz rpy>` (absent: identity).
@@ -46,28 +46,12 @@ fn urdf_origin(
     })
 }
 
-fn urdf_value(
-    path: &Path,
-    doc: &roxmltree::Document,
-    n: Node,
-    key: &str,
-) -> Result<f64, InteropError> {
-    let v = n
-        .attribute(key)
-        .ok_or_else(|| bad(path, doc, n, format!("no `{key}`")))?;
-    v.trim()
-        .parse::<f64>()
-        .ok()
-        .filter(|x| x.is_finite())
-        .ok_or_else(|| bad(path, doc, n, format!("`{key}` = \"{v}\" is not a number")))
-}
-
 fn urdf_geometry(path: &Path, doc: &roxmltree::Document, g: Node) -> Result<Shape, InteropError> {
     let s = g
         .children()
         .find(|n| n.is_element())
         .ok_or_else(|| bad(path, doc, g, "empty <geometry>".into()))?;
-    let v = |k: &str| urdf_value(path, doc, s, k);
+    let v = |k: &str| attr_number(path, doc, s, k);
     Ok(match s.tag_name().name() {
         "sphere" => Shape::Sphere(v("radius")?),
         "ellipsoid" => Shape::Ellipsoid(Vector3::new(v("a")?, v("b")?, v("c")?)),
@@ -157,7 +141,7 @@ fn read_inertial(
         .find(|n| n.has_tag_name("inertia"))
         .ok_or_else(|| bad(path, doc, i, "no <inertia>".into()))?;
     let g = |k: &str| {
-        urdf_value(path, doc, t, k).or_else(|e| {
+        attr_number(path, doc, t, k).or_else(|e| {
             if t.attribute(k).is_none() && k.len() == 3 && k.as_bytes()[1] != k.as_bytes()[2] {
                 Ok(0.0)
             } else {
@@ -177,7 +161,7 @@ fn read_inertial(
         g("izz")?,
     );
     Ok(MassProps {
-        mass_kg: urdf_value(path, doc, m, "value")?,
+        mass_kg: attr_number(path, doc, m, "value")?,
         com_m: Vector3::zeros(),
         inertia_com_kgm2: inertia,
     }
@@ -223,7 +207,7 @@ fn joint_kind(
 ) -> Result<Joint, InteropError> {
     let dynamics = j.children().find(|n| n.has_tag_name("dynamics"));
     let dyn_value = |k: &str| match dynamics.filter(|d| d.attribute(k).is_some()) {
-        Some(d) => urdf_value(path, doc, d, k),
+        Some(d) => attr_number(path, doc, d, k),
         None => Ok(0.0),
     };
     Ok(match kind {
@@ -252,13 +236,13 @@ fn joint_kind(
             }
             let range = match (kind, limit) {
                 ("revolute", Some(l)) => Some([
-                    urdf_value(path, doc, l, "lower")?,
-                    urdf_value(path, doc, l, "upper")?,
+                    attr_number(path, doc, l, "lower")?,
+                    attr_number(path, doc, l, "upper")?,
                 ]),
                 _ => None,
             };
             let effort_limit = match limit.filter(|l| l.attribute("effort").is_some()) {
-                Some(l) => Some(urdf_value(path, doc, l, "effort")?).filter(|e| *e > 0.0),
+                Some(l) => Some(attr_number(path, doc, l, "effort")?).filter(|e| *e > 0.0),
                 None => None,
             };
             Joint::Hinge {
@@ -343,8 +327,8 @@ fn read_transmission(
     let limit = efforts.get(&joint).copied().filter(|e| *e > 0.0);
     Ok(match gains {
         Some(g) => Actuator::Position {
-            kp: urdf_value(path, doc, g, "p")?,
-            kv: urdf_value(path, doc, g, "d")?,
+            kp: attr_number(path, doc, g, "p")?,
+            kv: attr_number(path, doc, g, "d")?,
             force_limit: limit,
             joint,
         },

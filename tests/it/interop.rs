@@ -372,6 +372,26 @@ fn a_hand_written_urdf_merges_fixed_links_and_reads_drake_properties() {
     );
 }
 
+/// The four values a hand-built walker fixes, each to 1e-12: its leg length `l`, its total
+/// mass, each leg's COM `com_below` the hip and its feet `foot_y` to either side.
+fn assert_hand_walker(d: &Design, l: f64, mass: f64, com_below: f64, foot_y: f64) {
+    let close = |got: f64, want: f64, what: &str| {
+        assert!((got - want).abs() < 1e-12, "{what}: {got}, by hand {want}");
+    };
+    close(d.geometry.leg_length_m, l, "leg length");
+    close(d.mass.total_mass_kg, mass, "total mass");
+    close(
+        d.mass.leg_com_height_over_l,
+        1.0 - com_below / l,
+        "leg COM height / L",
+    );
+    close(
+        d.geometry.foot_center_lateral_over_l,
+        foot_y / l,
+        "foot lateral / L",
+    );
+}
+
 /// Writes `text` as `name` in `dir` and checks that `survey sim import` refuses it (exit 2)
 /// with an error naming the file and holding `needle`.
 fn assert_import_refused(dir: &Path, name: &str, text: &str, needle: &str) {
@@ -584,13 +604,9 @@ fn a_urdf_hip_effort_without_transmission_limits_the_default_servo() {
 #[test]
 fn a_urdf_listing_child_links_first_imports_to_its_hand_worked_values() {
     let (d, _) = import_hand(&[("effort.urdf", EFFORT_URDF)]);
-    // Feet 0.3 m below the hip, radius 0.03: L = 0.33; 2 × (1.0 + 0.1) kg.
-    assert!((d.geometry.leg_length_m - 0.33).abs() < 1e-12);
-    assert!((d.mass.total_mass_kg - 2.2).abs() < 1e-12);
-    // Each leg's COM (1.0·0.15 + 0.1·0.3)/1.1 below the hip.
-    let h = 1.0 - (0.18 / 1.1) / 0.33;
-    assert!((d.mass.leg_com_height_over_l - h).abs() < 1e-12);
-    assert!((d.geometry.foot_center_lateral_over_l - 0.05 / 0.33).abs() < 1e-12);
+    // Feet 0.3 m below the hip, radius 0.03: L = 0.33; 2 × (1.0 + 0.1) kg; each leg's COM
+    // (1.0·0.15 + 0.1·0.3)/1.1 below the hip; the feet at y = ±0.05.
+    assert_hand_walker(&d, 0.33, 2.2, 0.18 / 1.1, 0.05);
 }
 
 /// The body's extent is exact for turned primitives: the swing leg's cylinder, 0.4 m long,
@@ -790,17 +806,14 @@ fn a_two_capsule_compass_walker_stands_on_its_capsule_ends() {
     let (d, text) = import_hand(&[("compass.xml", COMPASS_MJCF)]);
     // By hand: the hip on the capsules' upper end points; each lower end point 0.3 m below,
     // its hemisphere reaching 0.02 lower: L = 0.32. The foot is that end's sphere: 0.02.
-    assert!((d.geometry.leg_length_m - 0.32).abs() < 1e-12, "{text}");
     for s in d.geometry.foot_semi_axes_m {
         assert!((s - 0.02).abs() < 1e-12, "{text}");
     }
     // Each capsule: a cylinder π·0.02²·0.3 plus a ball 4/3·π·0.02³, times 1000 kg/m³;
-    // its COM at its middle, 0.15 m below the hip.
+    // its COM at its middle, 0.15 m below the hip. The feet under the legs, 0.05 m either
+    // side of the hip point, straight below it.
     let leg = 1000.0 * std::f64::consts::PI * (0.02f64.powi(2) * 0.3 + 4.0 / 3.0 * 0.02f64.powi(3));
-    assert!((d.mass.total_mass_kg - 2.0 * leg).abs() < 1e-12, "{text}");
-    assert!((d.mass.leg_com_height_over_l - (1.0 - 0.15 / 0.32)).abs() < 1e-12);
-    // The feet under the legs, 0.05 m either side of the hip point, straight below it.
-    assert!((d.geometry.foot_center_lateral_over_l - 0.05 / 0.32).abs() < 1e-12);
+    assert_hand_walker(&d, 0.32, 2.0 * leg, 0.15, 0.05);
     assert!(d.geometry.foot_center_forward_over_l.abs() < 1e-12);
     assert!(
         text.contains("capsule `left_leg` within 5° of vertical")
@@ -971,10 +984,7 @@ fn a_gazebo_style_sdf_with_empty_frame_attributes_imports() {
     let (d, _) = import_hand(&[("gz.sdf", GAZEBO_SDF)]);
     // Both sphere feet (r = 0.03) centred 0.3 below the hip at the links' common origin:
     // L = 0.33; the legs' COMs 0.15 below it; 2 × 1.0 kg; the feet at y = ±0.05.
-    assert!((d.geometry.leg_length_m - 0.33).abs() < 1e-12);
-    assert!((d.mass.total_mass_kg - 2.0).abs() < 1e-12);
-    assert!((d.mass.leg_com_height_over_l - (1.0 - 0.15 / 0.33)).abs() < 1e-12);
-    assert!((d.geometry.foot_center_lateral_over_l - 0.05 / 0.33).abs() < 1e-12);
+    assert_hand_walker(&d, 0.33, 2.0, 0.15, 0.05);
     // The hip's `<effort>1.5</effort>`.
     assert_eq!(servo_of(&d).1, 1.5);
 }
@@ -988,22 +998,9 @@ fn a_hand_written_sdf_imports_to_its_hand_worked_values() {
     // `__model__` pose puts the collision too. Both spheres (r = 0.03) are centred 0.3 below
     // the hip: L = 0.3 + 0.03 = 0.33 (had the 90° rolls been ignored, the 0.4 m shins would
     // reach 0.15 + 0.2 = 0.35 below the hip and be the feet).
-    assert!(
-        (d.geometry.leg_length_m - 0.33).abs() < 1e-12,
-        "{}",
-        d.geometry.leg_length_m
-    );
-    // 2 × (1.0 kg shin + 0.1 kg foot).
-    assert!((d.mass.total_mass_kg - 2.2).abs() < 1e-12);
-    // Each leg's COM (1.0 · 0.15 + 0.1 · 0.3) / 1.1 below the hip, over L.
-    let h = 1.0 - (0.18 / 1.1) / 0.33;
-    assert!(
-        (d.mass.leg_com_height_over_l - h).abs() < 1e-12,
-        "{}",
-        d.mass.leg_com_height_over_l
-    );
-    // The feet at y = ±0.05 (the swing one mirrored by the half turn).
-    assert!((d.geometry.foot_center_lateral_over_l - 0.05 / 0.33).abs() < 1e-12);
+    // 2 × (1.0 kg shin + 0.1 kg foot); each leg's COM (1.0 · 0.15 + 0.1 · 0.3) / 1.1 below
+    // the hip; the feet at y = ±0.05 (the swing one mirrored by the half turn).
+    assert_hand_walker(&d, 0.33, 2.2, 0.18 / 1.1, 0.05);
     assert_eq!(d.geometry.foot_semi_axes_m, [0.03, 0.03, 0.03]);
     // The hip's `<limit><effort>2</effort>`; its range's smaller side 0.5 rad.
     assert_eq!(servo_of(&d).1, 2.0);
